@@ -1,0 +1,83 @@
+# libhome build. `make` builds the library, the CLI and the tests; `make test` runs the suite;
+# `make demo` registers a generated structured pair. Cross builds: make CROSS_COMPILE=aarch64-linux-gnu-
+CROSS_COMPILE ?=
+ifeq ($(origin CC),default)
+CC := $(CROSS_COMPILE)gcc
+endif
+ifeq ($(origin AR),default)
+AR := $(CROSS_COMPILE)ar
+endif
+NM ?= $(CROSS_COMPILE)nm
+PREFIX ?= /usr/local
+BUILD ?= build
+SANITIZE ?=
+OPT ?= -O2
+# Run target binaries through this (e.g. qemu-aarch64-static -L /usr/aarch64-linux-gnu).
+RUNNER ?=
+
+WARN := -Wall -Wextra -Werror -pedantic
+CFLAGS_LIB := -std=c99 $(OPT) -g $(WARN) -Iinclude -fno-common $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) $(CFLAGS)
+CFLAGS_APP := -std=c99 $(OPT) -g $(WARN) -Iinclude -Iexamples $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) $(CFLAGS)
+LDFLAGS_APP := $(if $(SANITIZE),-fsanitize=$(SANITIZE)) $(LDFLAGS) -lm
+
+LIB_SRC := $(wildcard src/*.c)
+LIB_OBJ := $(patsubst src/%.c,$(BUILD)/obj/src/%.o,$(LIB_SRC))
+LIB := $(BUILD)/lib/libhome.a
+SUPPORT_OBJ := $(BUILD)/obj/examples/pgm.o $(BUILD)/obj/examples/synth.o
+TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/*.c))
+BINS := $(BUILD)/bin/home-register $(BUILD)/bin/home-make-pair $(BUILD)/bin/home-tests
+
+.PHONY: all test demo install clean
+all: $(LIB) $(BINS)
+
+$(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_internal.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_LIB) -c $< -o $@
+
+$(BUILD)/obj/examples/%.o: examples/%.c include/home.h $(wildcard examples/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) -c $< -o $@
+
+$(BUILD)/obj/tests/%.o: tests/%.c include/home.h $(wildcard tests/*.h examples/*.h src/home_internal.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) -Isrc -c $< -o $@
+
+$(LIB): $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@
+	$(AR) rcs $@ $^
+
+$(BUILD)/bin/home-register: $(BUILD)/obj/examples/home-register.o $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+
+$(BUILD)/bin/home-make-pair: $(BUILD)/obj/examples/make-pair.o $(SUPPORT_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+
+$(BUILD)/bin/home-tests: $(TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+
+test: all
+	BUILD=$(BUILD) NM="$(NM)" RUNNER="$(RUNNER)" bash tests/run.sh
+
+demo: all
+	@mkdir -p $(BUILD)/demo
+	$(RUNNER) $(BUILD)/bin/home-make-pair --p 25 --seed 7 $(BUILD)/demo/a.pgm $(BUILD)/demo/b.pgm > $(BUILD)/demo/truth.json
+	@echo "true H:      $$(cat $(BUILD)/demo/truth.json)"
+	@echo "home-register $(BUILD)/demo/a.pgm $(BUILD)/demo/b.pgm:"
+	@$(RUNNER) $(BUILD)/bin/home-register --save-hough $(BUILD)/demo/hough_a.pgm $(BUILD)/demo/a.pgm $(BUILD)/demo/b.pgm | tee $(BUILD)/demo/result.json
+	@python3 tests/corner_error.py $(BUILD)/demo/truth.json $(BUILD)/demo/result.json
+	@echo "Hough image of A with its keypoints: $(BUILD)/demo/hough_a.pgm"
+
+install: $(LIB)
+	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 include/home.h include/home_limits.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/
+	printf 'prefix=%s\nlibdir=$${prefix}/lib\nincludedir=$${prefix}/include\n\nName: home\nDescription: HOME Hough-space frame registration (allocation-free C99)\nVersion: %s\nLibs: -L$${libdir} -lhome -lm\nCflags: -I$${includedir}\n' \
+		'$(PREFIX)' "$$(sed -n 's/^#define HOME_VERSION_STRING "\(.*\)"/\1/p' include/home.h)" \
+		> $(DESTDIR)$(PREFIX)/lib/pkgconfig/home.pc
+
+clean:
+	rm -rf $(BUILD) build-*

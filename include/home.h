@@ -1,0 +1,164 @@
+/* libhome: HOME (Hough-space One-dimensional Matching of Extrema) frame registration.
+ *
+ * Pipeline: grey uint8 image -> texture-preserving Hough transform J(theta, r) -> Hough-space
+ * extrema as keypoints -> 1x16 uint8 radial descriptors -> L1 matching with a ratio test, same
+ * sign only -> homography from line correspondences by deterministic threshold halving + LM.
+ *
+ * Memory: the library never allocates. home_arena_size() tells how many bytes a context needs;
+ * home_init() lays the context out in a caller buffer aligned to HOME_ARENA_ALIGN. Features
+ * (home_features) are plain fixed-size structs the caller owns, so a video frame's features are
+ * extracted once and reused when the next frame is registered against it.
+ *
+ * Coordinates: pixel (x, y), x right, y down, centre of the top-left pixel = (0, 0). Hough lines
+ * are in centred coordinates xc = x - (W-1)/2, yc = y - (H-1)/2: xc*cos(theta) + yc*sin(theta) = r,
+ * theta in [0, pi). H maps image A's pixel coordinates to image B's, normalised to H[8] = 1.
+ *
+ * Threading: a context is used by one thread at a time; distinct contexts are independent.
+ */
+#ifndef HOME_H
+#define HOME_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "home_limits.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HOME_VERSION_MAJOR 0
+#define HOME_VERSION_MINOR 1
+#define HOME_VERSION_PATCH 0
+#define HOME_VERSION_STRING "0.1.0"
+
+/* Required alignment of the arena passed to home_init(). */
+#define HOME_ARENA_ALIGN 16
+
+/* Status codes: HOME_OK or a negative error. A registration that runs but does not find a
+ * trustworthy homography is not an error: it returns HOME_OK with result.ok == 0. */
+typedef enum home_status {
+    HOME_OK = 0,
+    HOME_E_NULL = -1,        /* a required pointer is NULL */
+    HOME_E_SIZE = -2,        /* width/height outside [HOME_MIN_SIDE, HOME_MAX_SIDE] */
+    HOME_E_STRIDE = -3,      /* stride smaller than the width */
+    HOME_E_CONFIG = -4,      /* a config value is out of range, NaN or Inf */
+    HOME_E_ARENA_SMALL = -5, /* arena smaller than home_arena_size() */
+    HOME_E_ARENA_ALIGN = -6, /* arena not aligned to HOME_ARENA_ALIGN */
+    HOME_E_MISMATCH = -7,    /* features from a different image size or config */
+    HOME_E_STATE = -8,       /* context or features not initialised (or overwritten) */
+    HOME_E_BUFFER = -9       /* an output buffer is too small */
+} home_status;
+
+/* Human-readable explanation of a status code (never NULL). */
+const char *home_strerror(int status);
+
+/* Optional timing hook: returns a monotonic time in milliseconds. The core has no OS clock. */
+typedef double (*home_clock_fn)(void *user);
+
+typedef struct home_config {
+    int width, height;        /* image size; both frames of a pair must have it */
+    int theta_bins;           /* bins over [0, pi); paper: 480 */
+    int wrap_band;            /* keypoints within this many theta bins of 0/pi are also matched
+                                 in their alternate form (theta +- pi, -r, -sign); ~10 deg */
+    float r_step;             /* px per r bin; 1.0 (the paper used 640 bins for the diagonal) */
+    int r_bins;               /* 0 = derive from r_step so the image diagonal is covered */
+    float smooth_sigma;       /* Gaussian smoothing of J, in bins; paper: 1.3 */
+    int keypoints_per_sign;   /* top-K extrema kept per sign of J; paper: 1000 */
+    float ratio;              /* Lowe ratio test; 0.9 (paper's baselines used 0.75) */
+    float threshold_start;    /* first inlier threshold, Hough pixels; halved down to ... */
+    float threshold_final;    /* ... this final threshold; paper: 1.0 */
+    int min_inliers;          /* fewer final inliers -> failure; paper: 20 */
+    home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */
+    void *clock_user;
+} home_config;
+
+/* Fill cfg with the paper's defaults for a width x height image. */
+int home_default_config(home_config *cfg, int width, int height);
+
+/* HOME_OK when every field is in range. */
+int home_validate_config(const home_config *cfg);
+
+/* Exact bytes home_init() needs for cfg; 0 when cfg is invalid. */
+size_t home_arena_size(const home_config *cfg);
+
+typedef struct home_context home_context;
+
+/* Lay a context out in arena (aligned to HOME_ARENA_ALIGN). On HOME_E_ARENA_SMALL, *needed (if
+ * not NULL) receives the size required. The config is copied. */
+int home_init(home_context **ctx, const home_config *cfg, void *arena, size_t arena_bytes,
+              size_t *needed);
+
+/* One keypoint: a Hough-space extremum, i.e. a line with a sign (bright-to-dark or reverse). */
+typedef struct home_keypoint {
+    float theta;              /* radians, [0, pi) */
+    float r;                  /* px, centred coordinates */
+    float saliency;           /* |det H / tr H| of J at the extremum */
+    int8_t sign;              /* +1 or -1: sign of J */
+    uint8_t has_alt;          /* near the theta wrap: alt_desc is valid */
+    uint8_t desc[HOME_DESC_LEN];
+    uint8_t alt_desc[HOME_DESC_LEN]; /* descriptor of (theta +- pi, -r, -sign) */
+} home_keypoint;
+
+/* A frame's features. Caller-owned; fill with home_extract(). Positive keypoints come first
+ * (kp[0 .. n_pos)), then negative ones, each sorted by decreasing saliency. */
+typedef struct home_features {
+    uint32_t magic;           /* set by home_extract() */
+    uint32_t config_id;       /* fingerprint of the config that made them */
+    int width, height;
+    int n_pos, n_neg;
+    float j_std;              /* standard deviation of J (quantisation scale) */
+    double ms_hough, ms_detect, ms_describe; /* extraction timings when a clock is set */
+    home_keypoint kp[2 * HOME_MAX_KEYPOINTS_PER_SIGN];
+} home_features;
+
+/* Extract features of one grey image (width x height from the config, rows stride bytes apart). */
+int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home_features *out);
+
+enum home_stage {
+    HOME_STAGE_HOUGH, HOME_STAGE_DETECT, HOME_STAGE_DESCRIBE, HOME_STAGE_MATCH,
+    HOME_STAGE_HOMOGRAPHY, HOME_STAGE_TOTAL, HOME_STAGE_COUNT
+};
+
+/* Why a registration did not succeed (result.ok == 0). */
+enum home_failure {
+    HOME_FAIL_NONE = 0,
+    HOME_FAIL_FEW_MATCHES,    /* too few matches to estimate a homography */
+    HOME_FAIL_FEW_INLIERS,    /* fewer than min_inliers at the final threshold */
+    HOME_FAIL_DEGENERATE      /* det(H / H22) <= 0, or the estimate is numerically unusable */
+};
+
+typedef struct home_result {
+    int ok;                   /* 1: H is trustworthy by the failure rule */
+    int failure;              /* enum home_failure */
+    double H[9];              /* A -> B, row-major, H[8] = 1 (identity when not ok) */
+    int keypoints_a, keypoints_b, matches, inliers;
+    double ms[HOME_STAGE_COUNT]; /* per-stage milliseconds (0 without a clock) */
+} home_result;
+
+/* Register features a (earlier frame) to b (current frame): H maps a's pixels to b's. */
+int home_match(home_context *ctx, const home_features *a, const home_features *b,
+               home_result *result);
+
+/* Convenience: extract both images into the context's own feature slots and register a to b. */
+int home_register(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const uint8_t *b,
+                  ptrdiff_t stride_b, home_result *result);
+
+/* The features home_register() last extracted (0: image a, 1: image b), or NULL. */
+const home_features *home_last_features(const home_context *ctx, int which);
+
+/* Size of the quantised Hough image home_render_hough() writes: r bins x theta bins. */
+int home_hough_size(const home_context *ctx, int *width, int *height);
+
+/* Render image's smoothed Hough image J quantised to uint8 (128 + J*127/(6*std)): row t is
+ * theta = t*pi/theta_bins, column i is r = (i - (r_bins-1)/2) * r_step. */
+int home_render_hough(home_context *ctx, const uint8_t *image, ptrdiff_t stride, uint8_t *out,
+                      ptrdiff_t out_stride);
+
+/* Map a keypoint to its (column, row) position in the rendered Hough image. */
+int home_keypoint_to_hough(const home_context *ctx, const home_keypoint *kp, float *col,
+                           float *row);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

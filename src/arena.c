@@ -1,0 +1,212 @@
+/* Configuration, arena layout and context initialisation. */
+#include "home_internal.h"
+#include <math.h>
+#include <string.h>
+
+const char *home_strerror(int status)
+{
+    switch (status) {
+    case HOME_OK: return "success";
+    case HOME_E_NULL: return "a required pointer argument is NULL";
+    case HOME_E_SIZE: return "image size out of range (each side must be in [HOME_MIN_SIDE, HOME_MAX_SIDE])";
+    case HOME_E_STRIDE: return "row stride is smaller than the image width";
+    case HOME_E_CONFIG: return "a configuration value is out of range, NaN or infinite";
+    case HOME_E_ARENA_SMALL: return "arena is smaller than home_arena_size() requires";
+    case HOME_E_ARENA_ALIGN: return "arena is not aligned to HOME_ARENA_ALIGN bytes";
+    case HOME_E_MISMATCH: return "features come from a different image size or configuration";
+    case HOME_E_STATE: return "context or features are not initialised (or were overwritten)";
+    case HOME_E_BUFFER: return "output buffer is too small";
+    default: return "unknown status code";
+    }
+}
+
+int home_default_config(home_config *cfg, int width, int height)
+{
+    if (!cfg) return HOME_E_NULL;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->width = width;
+    cfg->height = height;
+    cfg->theta_bins = 480;
+    cfg->wrap_band = 27;          /* 27 of 480 bins ~ 10 degrees */
+    cfg->r_step = 1.0f;
+    cfg->r_bins = 0;
+    cfg->smooth_sigma = 1.3f;
+    cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 1000 ? HOME_MAX_KEYPOINTS_PER_SIGN : 1000;
+    cfg->ratio = 0.9f;
+    cfg->threshold_start = 64.0f;
+    cfg->threshold_final = 1.0f;
+    cfg->min_inliers = 20;
+    if (width < HOME_MIN_SIDE || height < HOME_MIN_SIDE || width > HOME_MAX_SIDE ||
+        height > HOME_MAX_SIDE)
+        return HOME_E_SIZE;
+    return HOME_OK;
+}
+
+static int finite_in(float v, float lo, float hi)
+{
+    return isfinite(v) && v >= lo && v <= hi;
+}
+
+/* Bins needed so that |r| <= half diagonal (+1 bin of margin) fits; always even so r -> -r is
+ * the mirror i -> r_bins-1-i. */
+static int r_bins_for(int width, int height, float r_step)
+{
+    double half_diag = 0.5 * sqrt((double)(width - 1) * (width - 1) + (double)(height - 1) * (height - 1));
+    return 2 * ((int)ceil(half_diag / r_step) + 1);
+}
+
+int home__r_bins(const home_config *cfg)
+{
+    return cfg->r_bins ? cfg->r_bins : r_bins_for(cfg->width, cfg->height, cfg->r_step);
+}
+
+int home_validate_config(const home_config *cfg)
+{
+    if (!cfg) return HOME_E_NULL;
+    if (cfg->width < HOME_MIN_SIDE || cfg->height < HOME_MIN_SIDE ||
+        cfg->width > HOME_MAX_SIDE || cfg->height > HOME_MAX_SIDE)
+        return HOME_E_SIZE;
+    if (cfg->theta_bins < 16 || cfg->theta_bins > HOME_MAX_THETA_BINS) return HOME_E_CONFIG;
+    if (cfg->wrap_band < 0 || cfg->wrap_band > cfg->theta_bins / 4) return HOME_E_CONFIG;
+    if (!finite_in(cfg->r_step, 0.25f, 8.0f)) return HOME_E_CONFIG;
+    if (cfg->r_bins != 0) {
+        /* an explicit r axis must be even and cover the image diagonal */
+        if (cfg->r_bins < 0 || (cfg->r_bins & 1) ||
+            cfg->r_bins < r_bins_for(cfg->width, cfg->height, cfg->r_step) ||
+            cfg->r_bins > 4 * HOME_MAX_SIDE)
+            return HOME_E_CONFIG;
+    }
+    if (!finite_in(cfg->smooth_sigma, 0.3f, HOME__MAX_SMOOTH_RADIUS / 3.0f)) return HOME_E_CONFIG;
+    if (cfg->keypoints_per_sign < 8 || cfg->keypoints_per_sign > HOME_MAX_KEYPOINTS_PER_SIGN)
+        return HOME_E_CONFIG;
+    if (!finite_in(cfg->ratio, 0.1f, 1.0f)) return HOME_E_CONFIG;
+    if (!finite_in(cfg->threshold_final, 0.05f, 1000.0f)) return HOME_E_CONFIG;
+    if (!finite_in(cfg->threshold_start, cfg->threshold_final, 4096.0f)) return HOME_E_CONFIG;
+    /* the halving schedule must fit HOME_MAX_THRESHOLD_LEVELS */
+    if (cfg->threshold_start > cfg->threshold_final * (float)(1 << (HOME_MAX_THRESHOLD_LEVELS - 1)))
+        return HOME_E_CONFIG;
+    if (cfg->min_inliers < 4 || cfg->min_inliers > 2 * HOME_MAX_KEYPOINTS_PER_SIGN)
+        return HOME_E_CONFIG;
+    return HOME_OK;
+}
+
+/* FNV-1a over the fields that change what features mean. */
+uint32_t home__config_id(const home_config *cfg)
+{
+    uint32_t h = 2166136261u;
+    int32_t fields[6];
+    float ffields[2];
+    const unsigned char *p;
+    size_t i;
+    fields[0] = cfg->width; fields[1] = cfg->height; fields[2] = cfg->theta_bins;
+    fields[3] = home__r_bins(cfg); fields[4] = cfg->keypoints_per_sign; fields[5] = cfg->wrap_band;
+    ffields[0] = cfg->r_step; ffields[1] = cfg->smooth_sigma;
+    p = (const unsigned char *)fields;
+    for (i = 0; i < sizeof fields; i++) h = (h ^ p[i]) * 16777619u;
+    p = (const unsigned char *)ffields;
+    for (i = 0; i < sizeof ffields; i++) h = (h ^ p[i]) * 16777619u;
+    return h;
+}
+
+/* Arena layout: every block starts on a 64-byte boundary (cache line, widest SIMD load). */
+#define BLOCK_ALIGN 64u
+
+typedef struct layout {
+    size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, matches,
+        inliers, slots, total;
+    int max_matches;
+} layout;
+
+static size_t take(size_t *cursor, size_t bytes)
+{
+    size_t at = (*cursor + BLOCK_ALIGN - 1) & ~(size_t)(BLOCK_ALIGN - 1);
+    *cursor = at + bytes;
+    return at;
+}
+
+static void plan(const home_config *cfg, layout *l)
+{
+    size_t cur = 0, pixels = (size_t)cfg->width * (size_t)cfg->height;
+    size_t r_bins = (size_t)home__r_bins(cfg);
+    size_t radius = (size_t)ceil(3.0 * cfg->smooth_sigma);
+    /* every query keypoint, in primary and (near the wrap) alternate form, yields <= 1 match */
+    l->max_matches = 4 * cfg->keypoints_per_sign;
+    l->ctx = take(&cur, sizeof(home_context));
+    l->grad_x = take(&cur, pixels * sizeof(int16_t));
+    l->grad_y = take(&cur, pixels * sizeof(int16_t));
+    l->acc_x = take(&cur, r_bins * sizeof(int32_t));
+    l->acc_y = take(&cur, r_bins * sizeof(int32_t));
+    l->raw_rows = take(&cur, (2 * radius + 1) * r_bins * sizeof(float));
+    l->smooth_rows = take(&cur, HOME__DESC_ROWS * r_bins * sizeof(float));
+    l->row_tmp = take(&cur, r_bins * sizeof(float));
+    l->heap = take(&cur, 2 * (size_t)cfg->keypoints_per_sign * sizeof(home__candidate));
+    l->extrema = take(&cur, r_bins * sizeof(home__extremum));
+    l->matches = take(&cur, (size_t)l->max_matches * sizeof(home__match));
+    l->inliers = take(&cur, (size_t)l->max_matches * sizeof(int));
+    l->slots = take(&cur, 2 * sizeof(home_features));
+    l->total = (cur + BLOCK_ALIGN - 1) & ~(size_t)(BLOCK_ALIGN - 1);
+}
+
+size_t home_arena_size(const home_config *cfg)
+{
+    layout l;
+    if (home_validate_config(cfg) != HOME_OK) return 0;
+    plan(cfg, &l);
+    return l.total;
+}
+
+int home_init(home_context **out, const home_config *cfg, void *arena, size_t arena_bytes,
+              size_t *needed)
+{
+    layout l;
+    home_context *ctx;
+    unsigned char *base = (unsigned char *)arena;
+    int status;
+    if (needed) *needed = 0;
+    if (!out || !cfg || !arena) return HOME_E_NULL;
+    *out = NULL;
+    status = home_validate_config(cfg);
+    if (status != HOME_OK) return status;
+    if ((uintptr_t)arena % HOME_ARENA_ALIGN) return HOME_E_ARENA_ALIGN;
+    plan(cfg, &l);
+    if (needed) *needed = l.total;
+    if (arena_bytes < l.total) return HOME_E_ARENA_SMALL;
+
+    ctx = (home_context *)(void *)(base + l.ctx);
+    memset(ctx, 0, sizeof *ctx);
+    ctx->cfg = *cfg;
+    ctx->r_bins = home__r_bins(cfg);
+    ctx->cfg.r_bins = ctx->r_bins;
+    ctx->config_id = home__config_id(&ctx->cfg);
+    ctx->smooth_radius = home__gauss_taps(cfg->smooth_sigma, ctx->smooth_taps);
+    ctx->grad_x = (int16_t *)(void *)(base + l.grad_x);
+    ctx->grad_y = (int16_t *)(void *)(base + l.grad_y);
+    ctx->acc_x = (int32_t *)(void *)(base + l.acc_x);
+    ctx->acc_y = (int32_t *)(void *)(base + l.acc_y);
+    ctx->raw_rows = (float *)(void *)(base + l.raw_rows);
+    ctx->smooth_rows = (float *)(void *)(base + l.smooth_rows);
+    ctx->row_tmp = (float *)(void *)(base + l.row_tmp);
+    ctx->heap_items = (home__candidate *)(void *)(base + l.heap);
+    ctx->row_extrema = (home__extremum *)(void *)(base + l.extrema);
+    ctx->matches = (home__match *)(void *)(base + l.matches);
+    ctx->max_matches = l.max_matches;
+    ctx->inlier_index = (int *)(void *)(base + l.inliers);
+    ctx->slots = (home_features *)(void *)(base + l.slots);
+    ctx->slots[0].magic = ctx->slots[1].magic = 0;
+    ctx->slots_valid = 0;
+    ctx->magic = HOME__MAGIC_CTX;
+    *out = ctx;
+    return HOME_OK;
+}
+
+int home__check_image(const home_context *ctx, const uint8_t *image, ptrdiff_t stride)
+{
+    if (!image) return HOME_E_NULL;
+    if (stride < (ptrdiff_t)ctx->cfg.width) return HOME_E_STRIDE;
+    return HOME_OK;
+}
+
+double home__now(const home_context *ctx)
+{
+    return ctx->cfg.clock ? ctx->cfg.clock(ctx->cfg.clock_user) : 0.0;
+}

@@ -1,0 +1,116 @@
+/* Hough-space extrema as keypoints: strict 3x3 extrema, one Newton step to subpixel, saliency
+ * |det H / tr H|, and fixed-capacity min-heaps that keep the top-K per sign. */
+#include "home_internal.h"
+#include <math.h>
+
+/* Strict total order: higher saliency first, then earlier detection. */
+static int ranks_below(const home__candidate *a, const home__candidate *b)
+{
+    if (a->saliency != b->saliency) return a->saliency < b->saliency;
+    return a->order > b->order;
+}
+
+void home__heap_init(home__heap *heap, home__candidate *storage, int capacity)
+{
+    heap->items = storage;
+    heap->count = 0;
+    heap->capacity = capacity;
+}
+
+int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t order)
+{
+    home__candidate probe;
+    if (heap->count < heap->capacity) return 1;
+    probe.saliency = saliency;
+    probe.order = order;
+    return ranks_below(&heap->items[0], &probe);
+}
+
+static void sift_down(home__candidate *items, int count, int i)
+{
+    for (;;) {
+        int l = 2 * i + 1, r = l + 1, m = i;
+        home__candidate tmp;
+        if (l < count && ranks_below(&items[l], &items[m])) m = l;
+        if (r < count && ranks_below(&items[r], &items[m])) m = r;
+        if (m == i) return;
+        tmp = items[i]; items[i] = items[m]; items[m] = tmp;
+        i = m;
+    }
+}
+
+/* Insert, or replace the weakest when full (callers check home__heap_would_accept first). */
+void home__heap_push(home__heap *heap, const home__candidate *cand)
+{
+    if (heap->count < heap->capacity) {
+        int i = heap->count++;
+        heap->items[i] = *cand;
+        while (i > 0) {
+            int parent = (i - 1) / 2;
+            home__candidate tmp;
+            if (!ranks_below(&heap->items[i], &heap->items[parent])) break;
+            tmp = heap->items[i]; heap->items[i] = heap->items[parent]; heap->items[parent] = tmp;
+            i = parent;
+        }
+    } else if (ranks_below(&heap->items[0], cand)) {
+        heap->items[0] = *cand;
+        sift_down(heap->items, heap->count, 0);
+    }
+}
+
+/* In-place heap sort; afterwards items[0] is the most salient. Returns the count. */
+int home__heap_sort_desc(home__heap *heap)
+{
+    int n;
+    for (n = heap->count - 1; n > 0; n--) {
+        home__candidate tmp = heap->items[0];
+        heap->items[0] = heap->items[n];
+        heap->items[n] = tmp;
+        sift_down(heap->items, n, 0);
+    }
+    return heap->count;
+}
+
+int home__detect_row(const float *const *rows, int centre, int r_bins, int theta_bins,
+                     home__extremum *out)
+{
+    const float *up = rows[0], *mid = rows[1], *down = rows[2];
+    int i, n = 0;
+    for (i = 1; i < r_bins - 1; i++) {
+        float v = mid[i];
+        int sign;
+        double g_t, g_r, h_tt, h_rr, h_tr, det, step_t, step_r, theta;
+        if (v > 0.0f) {
+            if (!(v > mid[i - 1] && v > mid[i + 1] && v > up[i - 1] && v > up[i] && v > up[i + 1] &&
+                  v > down[i - 1] && v > down[i] && v > down[i + 1]))
+                continue;
+            sign = 1;
+        } else if (v < 0.0f) {
+            if (!(v < mid[i - 1] && v < mid[i + 1] && v < up[i - 1] && v < up[i] && v < up[i + 1] &&
+                  v < down[i - 1] && v < down[i] && v < down[i + 1]))
+                continue;
+            sign = -1;
+        } else {
+            continue;
+        }
+        /* central-difference gradient and Hessian; one Newton step */
+        g_t = 0.5 * ((double)down[i] - up[i]);
+        g_r = 0.5 * ((double)mid[i + 1] - mid[i - 1]);
+        h_tt = (double)down[i] - 2.0 * v + up[i];
+        h_rr = (double)mid[i + 1] - 2.0 * v + mid[i - 1];
+        h_tr = 0.25 * ((double)down[i + 1] - down[i - 1] - up[i + 1] + up[i - 1]);
+        det = h_tt * h_rr - h_tr * h_tr;
+        if (!(det > 0.0)) continue;                 /* a saddle, not an extremum */
+        step_t = -(h_rr * g_t - h_tr * g_r) / det;
+        step_r = -(h_tt * g_r - h_tr * g_t) / det;
+        if (fabs(step_t) > 1.0 || fabs(step_r) > 1.0) continue;
+        theta = centre + step_t;
+        if (theta < 0.0 || theta >= theta_bins) continue; /* the padding only serves as neighbours */
+        out[n].theta_bin = (float)theta;
+        out[n].r_bin = (float)(i + step_r);
+        out[n].saliency = (float)fabs(det / (h_tt + h_rr));
+        out[n].sign = sign;
+        n++;
+    }
+    return n;
+}

@@ -1,0 +1,116 @@
+/* Private declarations shared by libhome's stages. Names: home__ prefix or file-static. */
+#ifndef HOME_INTERNAL_H
+#define HOME_INTERNAL_H
+
+#include "home.h"
+
+#define HOME__MAGIC_CTX 0x484f4d43u   /* "HOMC" */
+#define HOME__MAGIC_FEAT 0x484f4d46u  /* "HOMF" */
+#define HOME__PI 3.14159265358979323846
+#define HOME__MAX_SMOOTH_RADIUS 8     /* sigma <= 2.6 bins */
+#define HOME__DESC_ROWS 5             /* smoothed rows kept: detection (3) + descriptor (+-2) */
+
+/* A keypoint candidate while the top-K heaps are filled. samples are the raw (float)
+ * descriptor values; they are quantised once J's standard deviation is known. */
+typedef struct home__candidate {
+    float theta_bin, r_bin, saliency;
+    uint32_t order;                   /* detection order: total-order tie break */
+    float samples[HOME_DESC_LEN];
+} home__candidate;
+
+typedef struct home__heap {
+    home__candidate *items;
+    int count, capacity;
+} home__heap;
+
+/* An extremum found on one theta row, before description. */
+typedef struct home__extremum {
+    float theta_bin, r_bin, saliency;
+    int sign;
+} home__extremum;
+
+/* A candidate match: line (theta_a, r_a) in A against (theta_b, r_b) in B. */
+typedef struct home__match {
+    float theta_a, r_a, theta_b, r_b;
+} home__match;
+
+struct home_context {
+    uint32_t magic;
+    home_config cfg;
+    uint32_t config_id;
+    int r_bins;
+    int smooth_radius;
+    float smooth_taps[2 * HOME__MAX_SMOOTH_RADIUS + 1];
+    /* arena-backed buffers */
+    int16_t *grad_x, *grad_y;         /* width x height, central differences, 0 on the border */
+    int32_t *acc_x, *acc_y;           /* r_bins: line sums of one theta row */
+    float *raw_rows;                  /* ring of (2*radius+1) r-smoothed rows */
+    float *smooth_rows;               /* ring of HOME__DESC_ROWS fully smoothed rows */
+    float *row_tmp;                   /* r_bins scratch */
+    home__candidate *heap_items;      /* 2 * keypoints_per_sign */
+    home__extremum *row_extrema;      /* r_bins: extrema of one theta row */
+    home__match *matches;             /* capacity max_matches */
+    int max_matches;
+    int *inlier_index;                /* max_matches: indices of current inliers */
+    home_features *slots;             /* 2: home_register()'s own features */
+    int slots_valid;
+};
+
+/* arena.c */
+uint32_t home__config_id(const home_config *cfg);
+int home__r_bins(const home_config *cfg);
+int home__check_image(const home_context *ctx, const uint8_t *image, ptrdiff_t stride);
+double home__now(const home_context *ctx);
+
+/* gradient.c */
+void home__gradient(const uint8_t *image, ptrdiff_t stride, int width, int height,
+                    int16_t *gx, int16_t *gy);
+
+/* hough.c: the texture-preserving Hough transform, streamed one theta row at a time so only a
+ * few rows are ever stored. For every fully smoothed row j in [-3, theta_bins + 2] it calls
+ * on_row with window[0..4] = smoothed rows j-4 .. j (older ones undefined while j < -3 + 4).
+ * Rows outside [0, theta_bins) are computed directly at theta < 0 or >= pi: they are the paper's
+ * padding J(theta +- pi, r) = -J(theta, -r). Returns the ms spent outside on_row. */
+typedef void (*home__row_fn)(void *user, int row, const float *const *window);
+void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width, int height,
+                                int32_t cos_q, int32_t sin_q, int32_t base_q, int32_t *acc_x,
+                                int32_t *acc_y, int r_bins);
+double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t stride,
+                          home__row_fn on_row, void *user);
+
+/* smooth.c */
+int home__gauss_taps(float sigma, float *taps);
+void home__smooth_r(const float *in, float *out, int n, const float *taps, int radius);
+void home__smooth_theta(const float *const *rows, float *out, int n, const float *taps,
+                        int radius);
+
+/* extrema.c */
+void home__heap_init(home__heap *heap, home__candidate *storage, int capacity);
+int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t order);
+void home__heap_push(home__heap *heap, const home__candidate *cand);
+int home__heap_sort_desc(home__heap *heap);
+/* Scan smoothed row rows[1] (rows[0..2] = centre-1 .. centre+1) for strict extrema with a valid
+ * Newton step whose refined theta lies in [0, theta_bins); returns how many were written. */
+int home__detect_row(const float *const *rows, int centre, int r_bins, int theta_bins,
+                     home__extremum *out);
+
+/* describe.c */
+void home__describe_samples(const float *const *rows, int centre, int r_bins, float theta_bin,
+                            float r_bin, float *samples);
+void home__quantise_descriptor(const float *samples, float scale, int reverse_negate,
+                               uint8_t *desc);
+
+/* match.c */
+int home__match_features(home_context *ctx, const home_features *a, const home_features *b);
+
+/* homography.c */
+int home__estimate_homography(home_context *ctx, int n_matches, home_result *result);
+
+/* lm.c: minimise sum |e_i(p)|^2 over 8 parameters; e_i has 3 components. */
+typedef void (*home__residual_fn)(const void *user, int i, const double *p, double *e,
+                                  double *jac /* 3 x 8, row-major, may be NULL */);
+int home__lm_solve(double *p, int n, const int *index, home__residual_fn fn, const void *user,
+                   int max_iters);
+int home__solve_spd8(double *a, double *b);
+
+#endif

@@ -1,0 +1,157 @@
+/* Homography from matched Hough keypoints (lines). Lines map by G = H^-T. G is estimated with
+ * G22 = 1 in normalised centred coordinates (r divided by the half diagonal, so the 8
+ * parameters are O(1)), by the paper's deterministic scheme: start at the identity, take the
+ * matches under a threshold as inliers, re-fit by LM, halve the threshold, down to the final one.
+ *
+ * Transfer error: the paper's (a, b, c)/|(a, b)| - (cos, sin, -r) mixes radians and pixels; the
+ * angle components are weighted by theta_bins/pi and the r component by 1/r_step so a residual
+ * is measured in Hough bins on both axes and thresholds read as Hough pixels (home-notes.md,
+ * finding 1). */
+#include "home_internal.h"
+#include <math.h>
+
+typedef struct line_problem {
+    const home__match *matches;
+    double scale;            /* half diagonal, px: normalises r */
+    double w_theta, w_r;     /* residual weights into Hough bins */
+} line_problem;
+
+static void line_residual(const void *user, int i, const double *g, double *e, double *jac)
+{
+    const line_problem *lp = (const line_problem *)user;
+    const home__match *m = &lp->matches[i];
+    double l0 = cos((double)m->theta_a), l1 = sin((double)m->theta_a);
+    double l2 = -(double)m->r_a / lp->scale;
+    double a = g[0] * l0 + g[1] * l1 + g[2] * l2;
+    double b = g[3] * l0 + g[4] * l1 + g[5] * l2;
+    double c = g[6] * l0 + g[7] * l1 + l2;
+    double nn = a * a + b * b, n = sqrt(nn);
+    if (!(n > 1e-12)) n = 1e-12, nn = n * n;
+    e[0] = lp->w_theta * (a / n - cos((double)m->theta_b));
+    e[1] = lp->w_theta * (b / n - sin((double)m->theta_b));
+    e[2] = lp->w_r * (c / n + (double)m->r_b / lp->scale);
+    if (jac) {
+        double n3 = nn * n, l[3];
+        double da_a = b * b / n3, da_b = -a * b / n3, db_b = a * a / n3;
+        double dc_a = -c * a / n3, dc_b = -c * b / n3, dc_c = 1.0 / n;
+        int k;
+        l[0] = l0; l[1] = l1; l[2] = l2;
+        for (k = 0; k < 3; k++) {
+            jac[0 * 8 + k] = lp->w_theta * da_a * l[k];
+            jac[0 * 8 + 3 + k] = lp->w_theta * da_b * l[k];
+            jac[1 * 8 + k] = lp->w_theta * da_b * l[k];
+            jac[1 * 8 + 3 + k] = lp->w_theta * db_b * l[k];
+            jac[2 * 8 + k] = lp->w_r * dc_a * l[k];
+            jac[2 * 8 + 3 + k] = lp->w_r * dc_b * l[k];
+        }
+        jac[0 * 8 + 6] = jac[0 * 8 + 7] = jac[1 * 8 + 6] = jac[1 * 8 + 7] = 0.0;
+        jac[2 * 8 + 6] = lp->w_r * dc_c * l0;
+        jac[2 * 8 + 7] = lp->w_r * dc_c * l1;
+    }
+}
+
+static int select_inliers(const line_problem *lp, int n, const double *g, double threshold,
+                          int *index)
+{
+    int i, count = 0;
+    double t2 = threshold * threshold, e[3];
+    for (i = 0; i < n; i++) {
+        line_residual(lp, i, g, e, NULL);
+        if (e[0] * e[0] + e[1] * e[1] + e[2] * e[2] < t2) index[count++] = i;
+    }
+    return count;
+}
+
+static double det3(const double *m)
+{
+    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+           m[2] * (m[3] * m[7] - m[4] * m[6]);
+}
+
+/* inverse transpose of a 3x3 matrix: (M^-1)^T = cofactor(M) / det */
+static int inverse_transpose(const double *m, double *out)
+{
+    double d = det3(m);
+    if (!(fabs(d) > 1e-300) || !isfinite(d)) return 0;
+    out[0] = (m[4] * m[8] - m[5] * m[7]) / d;
+    out[1] = -(m[3] * m[8] - m[5] * m[6]) / d;
+    out[2] = (m[3] * m[7] - m[4] * m[6]) / d;
+    out[3] = -(m[1] * m[8] - m[2] * m[7]) / d;
+    out[4] = (m[0] * m[8] - m[2] * m[6]) / d;
+    out[5] = -(m[0] * m[7] - m[1] * m[6]) / d;
+    out[6] = (m[1] * m[5] - m[2] * m[4]) / d;
+    out[7] = -(m[0] * m[5] - m[2] * m[3]) / d;
+    out[8] = (m[0] * m[4] - m[1] * m[3]) / d;
+    return 1;
+}
+
+static void set_identity(double *h)
+{
+    int k;
+    for (k = 0; k < 9; k++) h[k] = (k % 4 == 0) ? 1.0 : 0.0;
+}
+
+int home__estimate_homography(home_context *ctx, int n_matches, home_result *result)
+{
+    const home_config *cfg = &ctx->cfg;
+    const double cx = 0.5 * (cfg->width - 1), cy = 0.5 * (cfg->height - 1);
+    line_problem lp;
+    double g[8] = {1, 0, 0, 0, 1, 0, 0, 0};
+    double gm[9], hn[9], h[9], t;
+    int n_in = 0, k, level;
+
+    lp.matches = ctx->matches;
+    lp.scale = sqrt(cx * cx + cy * cy);
+    lp.w_theta = cfg->theta_bins / HOME__PI;
+    lp.w_r = lp.scale / cfg->r_step;
+    set_identity(result->H);
+    result->inliers = 0;
+    if (n_matches < 8) { result->failure = HOME_FAIL_FEW_MATCHES; return HOME_OK; }
+
+    t = cfg->threshold_start;
+    for (level = 0; level < HOME_MAX_THRESHOLD_LEVELS; level++) {
+        n_in = select_inliers(&lp, n_matches, g, t, ctx->inlier_index);
+        if (n_in < 6) break;               /* too few lines left to constrain 8 parameters */
+        if (!home__lm_solve(g, n_in, ctx->inlier_index, line_residual, &lp, HOME_LM_MAX_ITERS))
+            break;
+        if (t <= cfg->threshold_final) break;
+        t = t * 0.5 > cfg->threshold_final ? t * 0.5 : cfg->threshold_final;
+    }
+    n_in = select_inliers(&lp, n_matches, g, cfg->threshold_final, ctx->inlier_index);
+    result->inliers = n_in;
+
+    /* G (lines, normalised coords) -> H_n = G^-T -> pixel coordinates: H = S^-1 H_n S with
+     * S = [1/s 0 -cx/s; 0 1/s -cy/s; 0 0 1]. */
+    for (k = 0; k < 8; k++) gm[k] = g[k];
+    gm[8] = 1.0;
+    if (!inverse_transpose(gm, hn)) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
+    {
+        const double s = lp.scale;
+        double hs[9];
+        /* hs = H_n S */
+        for (k = 0; k < 3; k++) {
+            hs[k * 3 + 0] = hn[k * 3 + 0] / s;
+            hs[k * 3 + 1] = hn[k * 3 + 1] / s;
+            hs[k * 3 + 2] = -hn[k * 3 + 0] * cx / s - hn[k * 3 + 1] * cy / s + hn[k * 3 + 2];
+        }
+        /* h = S^-1 hs, S^-1 = [s 0 cx; 0 s cy; 0 0 1] */
+        for (k = 0; k < 3; k++) {
+            h[0 * 3 + k] = s * hs[0 * 3 + k] + cx * hs[2 * 3 + k];
+            h[1 * 3 + k] = s * hs[1 * 3 + k] + cy * hs[2 * 3 + k];
+            h[2 * 3 + k] = hs[2 * 3 + k];
+        }
+    }
+    if (!(fabs(h[8]) > 1e-12) || !isfinite(h[8])) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
+    {
+        const double h22 = h[8];
+        for (k = 0; k < 9; k++) h[k] /= h22;
+    }
+    for (k = 0; k < 9; k++)
+        if (!isfinite(h[k])) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
+    for (k = 0; k < 9; k++) result->H[k] = h[k];
+    if (!(det3(h) > 0.0)) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
+    if (n_in < cfg->min_inliers) { result->failure = HOME_FAIL_FEW_INLIERS; return HOME_OK; }
+    result->failure = HOME_FAIL_NONE;
+    result->ok = 1;
+    return HOME_OK;
+}

@@ -1,0 +1,16 @@
+/* Minimal test framework: TEST(name) functions registered in tests/test_main.c; CHECK records a
+ * failure with its location and keeps going. */
+#ifndef HOME_TEST_H
+#define HOME_TEST_H
+#include <stdio.h>
+
+extern int test_failures;
+#define CHECK(cond) do { if (!(cond)) { test_failures++; \
+    fprintf(stderr, "    %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
+#define CHECK_EQ_INT(a, b) do { long long a_ = (long long)(a), b_ = (long long)(b); if (a_ != b_) { \
+    test_failures++; fprintf(stderr, "    %s:%d: %s == %lld, expected %s == %lld\n", \
+    __FILE__, __LINE__, #a, a_, #b, b_); } } while (0)
+#define CHECK_LT(a, b) do { double a_ = (double)(a), b_ = (double)(b); if (!(a_ < b_)) { \
+    test_failures++; fprintf(stderr, "    %s:%d: %s = %g, expected < %s = %g\n", \
+    __FILE__, __LINE__, #a, a_, #b, b_); } } while (0)
+#endif

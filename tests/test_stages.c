@@ -1,0 +1,247 @@
+/* Per-stage tests against known truth. */
+#include "test.h"
+#include "test_util.h"
+#include "home_internal.h"
+#include "synth.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define IMG_W 320
+#define IMG_H 180
+static uint8_t img_a[IMG_W * IMG_H], img_b[IMG_W * IMG_H];
+static home_features feat_a, feat_b;
+
+void test_config_defaults(void)
+{
+    home_config cfg;
+    CHECK_EQ_INT(home_default_config(&cfg, 640, 360), HOME_OK);
+    CHECK_EQ_INT(cfg.theta_bins, 480);
+    CHECK_EQ_INT(cfg.keypoints_per_sign, 1000);
+    CHECK(fabsf(cfg.smooth_sigma - 1.3f) < 1e-6f);
+    CHECK(fabsf(cfg.threshold_final - 1.0f) < 1e-6f);
+    CHECK_EQ_INT(cfg.min_inliers, 20);
+    CHECK_EQ_INT(home_validate_config(&cfg), HOME_OK);
+    /* r axis covers the half diagonal (366.5 px at 640x360) at 1 px per bin, and is even */
+    CHECK_EQ_INT(home__r_bins(&cfg), 2 * 368);
+}
+
+void test_arena_layout(void)
+{
+    home_config cfg;
+    static union { unsigned char b[4u << 20]; double d; } mem;
+    home_context *ctx;
+    size_t need, got = 0;
+    home_default_config(&cfg, 640, 360);
+    need = home_arena_size(&cfg);
+    CHECK(need > 0);
+    CHECK(need <= (size_t)2 << 20);                          /* <= 2 MiB at 640x360 */
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem.b, need - 1, &got), HOME_E_ARENA_SMALL);
+    CHECK_EQ_INT(got, need);
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem.b + 1, need, NULL), HOME_E_ARENA_ALIGN);
+    /* the context stays inside exactly `need` bytes: a canary right after it survives use */
+    mem.b[need] = 0xA5;
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem.b, need, NULL), HOME_OK);
+    {
+        static uint8_t a[640 * 360];
+        home_result res;
+        synth_render(SYNTH_STRUCTURED, 3, (const double[9]){1, 0, 0, 0, 1, 0, 0, 0, 1}, 2.5, 9, a, 640, 360, 640);
+        CHECK_EQ_INT(home_register(ctx, a, 640, a, 640, &res), HOME_OK);
+    }
+    CHECK_EQ_INT(mem.b[need], 0xA5);
+}
+
+void test_heap_keeps_top_k(void)
+{
+    static home__candidate store[37];
+    home__heap heap;
+    float saliency[500];
+    int i, k;
+    synth_rng rng;
+    synth_seed(&rng, 5);
+    home__heap_init(&heap, store, 37);
+    for (i = 0; i < 500; i++) {
+        home__candidate c;
+        memset(&c, 0, sizeof c);
+        saliency[i] = (float)floor(synth_uniform(&rng) * 300); /* many ties */
+        c.saliency = saliency[i];
+        c.order = (uint32_t)i;
+        c.theta_bin = (float)i;
+        if (home__heap_would_accept(&heap, c.saliency, c.order)) home__heap_push(&heap, &c);
+    }
+    CHECK_EQ_INT(home__heap_sort_desc(&heap), 37);
+    /* exactly the 37 best by (saliency desc, order asc), in that order */
+    for (k = 0; k < 37; k++) {
+        int best = -1;
+        for (i = 0; i < 500; i++)
+            if (saliency[i] >= 0 && (best < 0 || saliency[i] > saliency[best])) best = i;
+        CHECK_EQ_INT((int)store[k].theta_bin, best);
+        saliency[best] = -1;
+    }
+}
+
+/* A single straight step edge: bright side where xc cos(t) + yc sin(t) > r. */
+static void render_edge(uint8_t *img, double theta, double r, double contrast)
+{
+    int x, y;
+    for (y = 0; y < IMG_H; y++)
+        for (x = 0; x < IMG_W; x++) {
+            double d = (x - 0.5 * (IMG_W - 1)) * cos(theta) + (y - 0.5 * (IMG_H - 1)) * sin(theta) - r;
+            double v = 100 + contrast / (1 + exp(-d / 0.7));
+            img[y * IMG_W + x] = (uint8_t)floor(v + 0.5);
+        }
+}
+
+void test_hough_edge_extremum(void)
+{
+    static const double cases[][3] = {{0.7, 12.0, 60}, {2.2, -30.5, -60}, {1.5708, 20.25, 50}};
+    size_t c;
+    home_context *ctx = test_context(IMG_W, IMG_H, NULL);
+    CHECK(ctx != NULL);
+    if (!ctx) return;
+    for (c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        double theta = cases[c][0], r = cases[c][1], contrast = cases[c][2];
+        const home_keypoint *kp;
+        render_edge(img_a, theta, r, contrast);
+        CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &feat_a), HOME_OK);
+        /* the strongest extremum is the edge, with the sign of the contrast along n(theta) */
+        kp = contrast > 0 ? &feat_a.kp[0] : &feat_a.kp[feat_a.n_pos];
+        CHECK(contrast > 0 ? feat_a.n_pos > 0 : feat_a.n_neg > 0);
+        CHECK_EQ_INT(kp->sign, contrast > 0 ? 1 : -1);
+        CHECK_LT(fabs(kp->theta - theta), 0.2 * HOME__PI / 480);
+        CHECK_LT(fabs(kp->r - r), 0.15);
+        /* and it dominates: no other keypoint of that sign is half as salient */
+        CHECK_LT(kp[1].saliency, 0.5 * kp->saliency);
+    }
+}
+
+void test_hough_wrap_symmetry(void)
+{
+    /* a vertical edge sits at the theta wrap: theta ~ 0 with r, or theta ~ pi with -r and the
+     * opposite sign. It must be found once, flagged for the alternate form. */
+    home_context *ctx = test_context(IMG_W, IMG_H, NULL);
+    const home_keypoint *kp;
+    if (!ctx) { CHECK(0); return; }
+    render_edge(img_a, 0.004, 25.0, 60);
+    CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &feat_a), HOME_OK);
+    kp = &feat_a.kp[0];
+    CHECK(feat_a.n_pos > 0 && kp->has_alt);
+    CHECK_LT(fabs(kp->theta - 0.004), 0.002);
+    CHECK_LT(fabs(kp->r - 25.0), 0.2);
+    /* alternate descriptor is the primary reversed and mirrored around 128 */
+    CHECK_LT(abs((int)kp->alt_desc[0] - (256 - kp->desc[15])), 2);
+    CHECK_LT(abs((int)kp->alt_desc[7] - (256 - kp->desc[8])), 2);
+}
+
+static double rotate_translate(double *h, double angle, double tx, double ty)
+{
+    double cx = 0.5 * (IMG_W - 1), cy = 0.5 * (IMG_H - 1), c = cos(angle), s = sin(angle);
+    h[0] = c; h[1] = -s; h[2] = cx - c * cx + s * cy + tx;
+    h[3] = s; h[4] = c; h[5] = cy - s * cx - c * cy + ty;
+    h[6] = h[7] = 0; h[8] = 1;
+    return 0;
+}
+
+void test_descriptor_invariance(void)
+{
+    /* the radial pattern across parallel lines survives rotation and translation */
+    static const double motions[][3] = {{0.0, 7.3, -4.1}, {0.15, 3.0, 5.0}, {-0.3, -6.0, 2.5}};
+    home_context *ctx = test_context(IMG_W, IMG_H, NULL);
+    size_t m;
+    double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    if (!ctx) { CHECK(0); return; }
+    synth_render(SYNTH_STRUCTURED, 11, ident, 0.0, 1, img_a, IMG_W, IMG_H, IMG_W);
+    CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &feat_a), HOME_OK);
+    for (m = 0; m < sizeof motions / sizeof motions[0]; m++) {
+        double h[9];
+        int i, j, compared = 0, close = 0;
+        rotate_translate(h, motions[m][0], motions[m][1], motions[m][2]);
+        synth_render(SYNTH_STRUCTURED, 11, h, 0.0, 1, img_b, IMG_W, IMG_H, IMG_W);
+        CHECK_EQ_INT(home_extract(ctx, img_b, IMG_W, &feat_b), HOME_OK);
+        /* for the 20 most salient positive lines of A, find the keypoint of B at the mapped
+         * (theta, r) and compare descriptors (mean absolute difference per value) */
+        for (i = 0; i < 20 && i < feat_a.n_pos; i++) {
+            double tb, rb, best = 1e9;
+            int jb = -1;
+            test_map_line(h, IMG_W, IMG_H, feat_a.kp[i].theta, feat_a.kp[i].r, &tb, &rb);
+            if (tb < 0) continue; /* crossed the wrap: covered by the wrap test */
+            for (j = 0; j < feat_b.n_pos; j++) {
+                double d = fabs(feat_b.kp[j].theta - tb) * 480 / HOME__PI + fabs(feat_b.kp[j].r - rb);
+                if (d < best) best = d, jb = j;
+            }
+            if (jb < 0 || best > 2.0) continue;
+            compared++;
+            {
+                int k, sad = 0;
+                for (k = 0; k < HOME_DESC_LEN; k++) sad += abs(feat_a.kp[i].desc[k] - feat_b.kp[jb].desc[k]);
+                if (sad <= 3 * HOME_DESC_LEN) close++;
+            }
+        }
+        CHECK(compared >= 12);
+        CHECK(close >= compared * 8 / 10);
+    }
+}
+
+/* Matches from exact line correspondences of pixel homography h. */
+static int exact_matches(home_context *ctx, const double *h, int n, double outlier_share,
+                         double noise, synth_rng *rng)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        double theta = HOME__PI * synth_uniform(rng), r = 150 * (synth_uniform(rng) - 0.5);
+        double tb, rb;
+        test_map_line(h, IMG_W, IMG_H, theta, r, &tb, &rb);
+        if (synth_uniform(rng) < outlier_share) {
+            tb = HOME__PI * synth_uniform(rng);
+            rb = 150 * (synth_uniform(rng) - 0.5);
+        } else {
+            tb += noise * synth_gauss(rng) * HOME__PI / 480;
+            rb += noise * synth_gauss(rng);
+        }
+        ctx->matches[i].theta_a = (float)theta;
+        ctx->matches[i].r_a = (float)r;
+        ctx->matches[i].theta_b = (float)tb;
+        ctx->matches[i].r_b = (float)rb;
+    }
+    return n;
+}
+
+void test_lm_exact_lines(void)
+{
+    home_context *ctx = test_context(IMG_W, IMG_H, NULL);
+    synth_rng rng;
+    int trial;
+    if (!ctx) { CHECK(0); return; }
+    synth_seed(&rng, 77);
+    for (trial = 0; trial < 5; trial++) {
+        double h[9];
+        home_result res;
+        memset(&res, 0, sizeof res);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 8 + 4 * trial, h);
+        exact_matches(ctx, h, 60, 0.0, 0.0, &rng);
+        home__estimate_homography(ctx, 60, &res);
+        CHECK(res.ok);
+        CHECK_EQ_INT(res.inliers, 60);
+        CHECK_LT(synth_corner_error(res.H, h, IMG_W, IMG_H), 1e-3);
+    }
+}
+
+void test_halving_with_outliers(void)
+{
+    home_context *ctx = test_context(IMG_W, IMG_H, NULL);
+    synth_rng rng;
+    int trial;
+    if (!ctx) { CHECK(0); return; }
+    synth_seed(&rng, 78);
+    for (trial = 0; trial < 5; trial++) {
+        double h[9];
+        home_result res;
+        memset(&res, 0, sizeof res);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 10 + 4 * trial, h);
+        exact_matches(ctx, h, 300, 0.3, 0.3, &rng);
+        home__estimate_homography(ctx, 300, &res);
+        CHECK(res.ok);
+        CHECK(res.inliers >= 150);
+        CHECK_LT(synth_corner_error(res.H, h, IMG_W, IMG_H), 0.3);
+    }
+}
