@@ -60,7 +60,7 @@ $(BUILD)/bin/home-tests: $(TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
 test: all
-	BUILD=$(BUILD) NM="$(NM)" RUNNER="$(RUNNER)" bash tests/run.sh
+	BUILD=$(BUILD) NM="$(NM)" RUNNER="$(RUNNER)" CC="$(CC)" SANFLAGS="$(if $(SANITIZE),-fsanitize=$(SANITIZE))" bash tests/run.sh
 
 demo: all
 	@mkdir -p $(BUILD)/demo

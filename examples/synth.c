@@ -94,43 +94,68 @@ static double step(double d)
     return 1.0 / (1.0 + exp(-d / 0.6));
 }
 
-/* Smooth pseudo-random "value noise" for faint texture: a few incommensurate sinusoids. */
-static double blotches(double x, double y, uint32_t variant)
+/* Lattice value noise: a hashed random grey level per integer cell corner, smoothly
+ * interpolated; two octaves give a faint, photograph-like texture. */
+static double lattice(int64_t x, int64_t y, uint32_t variant)
 {
-    double v = 0.0;
-    int k;
-    for (k = 0; k < 6; k++) {
-        double fx = 0.013 * (k + 1) * (1.0 + 0.1 * ((variant + k) % 5));
-        double fy = 0.017 * (k + 2) * (1.0 + 0.07 * ((variant * 3 + k) % 7));
-        v += sin(fx * x + 1.7 * k + variant) * cos(fy * y + 0.3 * k);
-    }
-    return v / 6.0;
+    uint64_t z = (uint64_t)(x * 73856093) ^ (uint64_t)(y * 19349663) ^ ((uint64_t)variant << 32);
+    z = (z ^ (z >> 33)) * 0xff51afd7ed558ccdull;
+    z = (z ^ (z >> 33)) * 0xc4ceb9fe1a85ec53ull;
+    z ^= z >> 33;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0) * 2.0 - 1.0;
 }
 
+static double value_noise(double x, double y, double cell, uint32_t variant)
+{
+    double fx = x / cell, fy = y / cell, x0 = floor(fx), y0 = floor(fy);
+    double tx = fx - x0, ty = fy - y0;
+    int64_t ix = (int64_t)x0, iy = (int64_t)y0;
+    tx = tx * tx * (3 - 2 * tx);
+    ty = ty * ty * (3 - 2 * ty);
+    return (1 - ty) * ((1 - tx) * lattice(ix, iy, variant) + tx * lattice(ix + 1, iy, variant)) +
+           ty * ((1 - tx) * lattice(ix, iy + 1, variant) + tx * lattice(ix + 1, iy + 1, variant));
+}
+
+/* Scene in scene coordinates (nominally 640x360 but defined everywhere): smooth shading,
+ * long straight edges, a facade-like grid of rectangles, and faint texture. The weak-texture
+ * kind has the same kinds of structure at a quarter of the contrast and fewer of them. */
 static double scene(enum synth_kind kind, uint32_t variant, double x, double y)
 {
-    /* layout derived from the variant with a tiny hash: stable across platforms */
     synth_rng rng;
-    double v;
-    int k, n_lines, n_rects;
+    double v, gain = kind == SYNTH_STRUCTURED ? 1.0 : 0.3;
+    int k, n_lines = kind == SYNTH_STRUCTURED ? 6 : 3, rows, cols, i, j;
+    double gx0, gy0, gdx, gdy, ww, wh;
     if (kind == SYNTH_CONSTANT) return 128.0;
     synth_seed(&rng, 1000 + variant);
-    v = 110 + 35 * sin(x / (80.0 + 30 * synth_uniform(&rng))) * cos(y / (60.0 + 30 * synth_uniform(&rng)));
-    n_lines = kind == SYNTH_STRUCTURED ? 7 : 3;
-    n_rects = kind == SYNTH_STRUCTURED ? 4 : 1;
+    v = 110 + 30 * sin(x / (80.0 + 30 * synth_uniform(&rng))) * cos(y / (60.0 + 30 * synth_uniform(&rng)));
     for (k = 0; k < n_lines; k++) {
         double a = 3.14159265358979 * synth_uniform(&rng);
         double r = 260 * (synth_uniform(&rng) - 0.5);
-        double c = (kind == SYNTH_STRUCTURED ? 45 : 14) * (synth_uniform(&rng) < 0.5 ? -1 : 1);
+        double c = gain * (20 + 25 * synth_uniform(&rng)) * (synth_uniform(&rng) < 0.5 ? -1 : 1);
         v += c * step((x - 320) * cos(a) + (y - 180) * sin(a) - r);
     }
-    for (k = 0; k < n_rects; k++) {
-        double x0 = 40 + 500 * synth_uniform(&rng), y0 = 30 + 260 * synth_uniform(&rng);
-        double w = 40 + 140 * synth_uniform(&rng), h = 30 + 100 * synth_uniform(&rng);
-        double c = (kind == SYNTH_STRUCTURED ? 50 : 16) * (synth_uniform(&rng) < 0.5 ? -1 : 1);
-        v += c * step(x - x0) * step(x0 + w - x) * step(y - y0) * step(y0 + h - y);
+    /* a grid of "windows" on a slightly rotated facade */
+    rows = 2 + (int)(3 * synth_uniform(&rng));
+    cols = 3 + (int)(4 * synth_uniform(&rng));
+    gx0 = 40 + 120 * synth_uniform(&rng);
+    gy0 = 30 + 80 * synth_uniform(&rng);
+    gdx = (560 - gx0) / cols;
+    gdy = (330 - gy0) / rows;
+    ww = gdx * (0.4 + 0.3 * synth_uniform(&rng));
+    wh = gdy * (0.4 + 0.3 * synth_uniform(&rng));
+    {
+        double c = gain * (30 + 20 * synth_uniform(&rng)) * (synth_uniform(&rng) < 0.5 ? -1 : 1);
+        double rot = 0.2 * (synth_uniform(&rng) - 0.5), cr = cos(rot), sr = sin(rot);
+        double u = (x - 320) * cr + (y - 180) * sr + 320, w = -(x - 320) * sr + (y - 180) * cr + 180;
+        i = (int)floor((u - gx0) / gdx);
+        j = (int)floor((w - gy0) / gdy);
+        if (i >= 0 && i < cols && j >= 0 && j < rows) {
+            double x0 = gx0 + i * gdx, y0 = gy0 + j * gdy;
+            v += c * step(u - x0) * step(x0 + ww - u) * step(w - y0) * step(y0 + wh - w);
+        }
     }
-    v += (kind == SYNTH_STRUCTURED ? 6 : 10) * blotches(x, y, variant);
+    v += (kind == SYNTH_STRUCTURED ? 8 : 5) * value_noise(x, y, 5.0, variant) +
+         (kind == SYNTH_STRUCTURED ? 10 : 6) * value_noise(x, y, 23.0, variant + 7);
     return v;
 }
 
