@@ -22,13 +22,19 @@ LDFLAGS_APP := $(if $(SANITIZE),-fsanitize=$(SANITIZE)) $(LDFLAGS) -lm
 
 LIB_SRC := $(wildcard src/*.c)
 LIB_OBJ := $(patsubst src/%.c,$(BUILD)/obj/src/%.o,$(LIB_SRC))
+# Feature areas add their own programs, test binaries and rules in mk/*.mk:
+#   BINS += ...  (built by `make`), TEST_BINS += ... (run by `make test`, each prints
+#   "N passed, N failed" last), LIB_OBJ += ... (extra library objects, e.g. port/ kernels).
 LIB := $(BUILD)/lib/libhome.a
 SUPPORT_OBJ := $(BUILD)/obj/examples/pgm.o $(BUILD)/obj/examples/synth.o
 TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/*.c))
 BINS := $(BUILD)/bin/home-register $(BUILD)/bin/home-make-pair $(BUILD)/bin/home-tests
+TEST_BINS := $(BUILD)/bin/home-tests
 
 .PHONY: all test demo install clean
 all: $(LIB) $(BINS)
+
+-include $(sort $(wildcard mk/*.mk))
 
 $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_internal.h
 	@mkdir -p $(dir $@)
@@ -60,7 +66,7 @@ $(BUILD)/bin/home-tests: $(TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
 test: all
-	BUILD=$(BUILD) NM="$(NM)" RUNNER="$(RUNNER)" CC="$(CC)" SANFLAGS="$(if $(SANITIZE),-fsanitize=$(SANITIZE))" bash tests/run.sh
+	BUILD=$(BUILD) NM="$(NM)" RUNNER="$(RUNNER)" CC="$(CC)" TEST_BINS="$(TEST_BINS)" SANFLAGS="$(if $(SANITIZE),-fsanitize=$(SANITIZE))" bash tests/run.sh
 
 demo: all
 	@mkdir -p $(BUILD)/demo

@@ -14,17 +14,20 @@ trap 'rm -rf "$tmp"' EXIT
 ok() { passed=$((passed + 1)); echo "ok   $1"; }
 fail() { failed=$((failed + 1)); echo "FAIL $1${2:+: $2}"; }
 
-# 1. unit and end-to-end tests
-$RUNNER "$BUILD/bin/home-tests" > "$tmp/unit.out"
-unit_status=$?
-cat "$tmp/unit.out"
-line=$(tail -n 1 "$tmp/unit.out")
-if [[ $line =~ ^([0-9]+)\ passed,\ ([0-9]+)\ failed$ ]]; then
-  passed=$((passed + BASH_REMATCH[1])); failed=$((failed + BASH_REMATCH[2]))
-  [ "$unit_status" -eq 0 ] || [ "${BASH_REMATCH[2]}" -gt 0 ] || fail home-tests "exit status $unit_status"
-else
-  fail home-tests "crashed or printed no summary (exit status $unit_status)"
-fi
+# 1. test binaries (unit, end-to-end; areas add theirs to TEST_BINS in mk/*.mk)
+for bin in ${TEST_BINS:-$BUILD/bin/home-tests}; do
+  name=$(basename "$bin")
+  $RUNNER "$bin" > "$tmp/unit.out"
+  unit_status=$?
+  cat "$tmp/unit.out"
+  line=$(tail -n 1 "$tmp/unit.out")
+  if [[ $line =~ ^([0-9]+)\ passed,\ ([0-9]+)\ failed$ ]]; then
+    passed=$((passed + BASH_REMATCH[1])); failed=$((failed + BASH_REMATCH[2]))
+    [ "$unit_status" -eq 0 ] || [ "${BASH_REMATCH[2]}" -gt 0 ] || fail "$name" "exit status $unit_status"
+  else
+    fail "$name" "crashed or printed no summary (exit status $unit_status)"
+  fi
+done
 
 # 2. the library is allocation-free and has no writable globals
 lib="$BUILD/lib/libhome.a"
@@ -108,6 +111,14 @@ if [ -z "$RUNNER" ]; then
      ${CC:-cc} ${SANFLAGS:-} -std=c99 -I"$tmp/dest/opt/home/include" "$tmp/use.c" "$tmp/dest/opt/home/lib/libhome.a" -lm -o "$tmp/use" &&
      "$tmp/use"; then ok make_install; else fail make_install; fi
 fi
+
+# 5. checks of other areas: tests/checks/*.sh are sourced here and use ok/fail, $tmp, $BUILD,
+#    $RUNNER
+for check in tests/checks/*.sh; do
+  [ -f "$check" ] || continue
+  # shellcheck source=/dev/null
+  . "$check"
+done
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
