@@ -12,16 +12,16 @@ PREFIX ?= /usr/local
 BUILD ?= build
 SANITIZE ?=
 OPT ?= -O2
-# Run target binaries through this (e.g. qemu-aarch64-static -L /usr/aarch64-linux-gnu).
-RUNNER ?=
+# RUNNER: run target binaries through this (cross builds default to qemu-user, port/toolchain.mk).
 
 WARN := -Wall -Wextra -Werror -pedantic
-CFLAGS_LIB := -std=c99 $(OPT) -g $(WARN) -Iinclude -fno-common $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) $(CFLAGS)
-CFLAGS_APP := -std=c99 $(OPT) -g $(WARN) -Iinclude -Iexamples $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) $(CFLAGS)
+-include port/toolchain.mk
+CFLAGS_LIB := -std=c99 $(OPT) -g $(WARN) -Iinclude -Iport -fno-common $(ARCH_FLAGS) $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) $(CFLAGS)
+CFLAGS_APP := -std=c99 $(OPT) -g $(WARN) -Iinclude -Iexamples $(ARCH_FLAGS) $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) $(CFLAGS)
 LDFLAGS_APP := $(if $(SANITIZE),-fsanitize=$(SANITIZE)) $(LDFLAGS) -lm
 
-LIB_SRC := $(wildcard src/*.c)
-LIB_OBJ := $(patsubst src/%.c,$(BUILD)/obj/src/%.o,$(LIB_SRC))
+LIB_SRC := $(wildcard src/*.c) $(wildcard port/*.c)
+LIB_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 # Feature areas add their own programs, test binaries and rules in mk/*.mk:
 #   BINS += ...  (built by `make`), TEST_BINS += ... (run by `make test`, each prints
 #   "N passed, N failed" last), LIB_OBJ += ... (extra library objects, e.g. port/ kernels).
@@ -36,7 +36,11 @@ all: $(LIB) $(BINS)
 
 -include $(sort $(wildcard mk/*.mk))
 
-$(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_internal.h
+$(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_internal.h port/kernels.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_LIB) -c $< -o $@
+
+$(BUILD)/obj/port/%.o: port/%.c include/home.h include/home_limits.h port/kernels.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_LIB) -c $< -o $@
 
@@ -46,7 +50,7 @@ $(BUILD)/obj/examples/%.o: examples/%.c include/home.h $(wildcard examples/*.h)
 
 $(BUILD)/obj/tests/%.o: tests/%.c include/home.h $(wildcard tests/*.h examples/*.h src/home_internal.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) -Isrc -c $< -o $@
+	$(CC) $(CFLAGS_APP) -Isrc -Iport -c $< -o $@
 
 $(LIB): $(LIB_OBJ)
 	@mkdir -p $(dir $@)

@@ -55,6 +55,17 @@ const char *home_strerror(int status);
 /* Optional timing hook: returns a monotonic time in milliseconds. The core has no OS clock. */
 typedef double (*home_clock_fn)(void *user);
 
+/* SIMD backend of a context. Every backend gives bit-identical results. home_default_config()
+ * takes it from the environment variable HOME_SIMD=none|sse|neon when set (compile the library
+ * with -DHOME_NO_GETENV for targets without an environment). */
+enum home_simd { HOME_SIMD_AUTO = 0, HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_NEON };
+
+/* How J(theta, r) is computed. FAST: shear-and-add line sums of the image (one channel, exact
+ * integer sums along nearest-pixel digital lines, SIMD), differentiated across lines with the
+ * line ends handled exactly. EXACT: the paper's definition pixel by pixel (gradient summed into
+ * nearest r bins), the slow reference. */
+enum home_hough_method { HOME_HOUGH_FAST = 0, HOME_HOUGH_EXACT };
+
 typedef struct home_config {
     int width, height;        /* image size; both frames of a pair must have it */
     int theta_bins;           /* bins over [0, pi); paper: 480 */
@@ -68,6 +79,8 @@ typedef struct home_config {
     float threshold_start;    /* first inlier threshold, Hough pixels; halved down to ... */
     float threshold_final;    /* ... this final threshold; paper: 1.0 */
     int min_inliers;          /* fewer final inliers -> failure; paper: 20 */
+    int simd;                 /* enum home_simd */
+    int hough_method;         /* enum home_hough_method */
     home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */
     void *clock_user;
 } home_config;
@@ -78,10 +91,14 @@ int home_default_config(home_config *cfg, int width, int height);
 /* HOME_OK when every field is in range. */
 int home_validate_config(const home_config *cfg);
 
+typedef struct home_context home_context;
+
+/* Name of the SIMD backend a context uses ("none", "sse", "neon"); with ctx == NULL, the
+ * backend HOME_SIMD_AUTO would pick in this build. */
+const char *home_simd_backend(const home_context *ctx);
+
 /* Exact bytes home_init() needs for cfg; 0 when cfg is invalid. */
 size_t home_arena_size(const home_config *cfg);
-
-typedef struct home_context home_context;
 
 /* Lay a context out in arena (aligned to HOME_ARENA_ALIGN). On HOME_E_ARENA_SMALL, *needed (if
  * not NULL) receives the size required. The config is copied. */

@@ -1,6 +1,7 @@
 /* Configuration, arena layout and context initialisation. */
 #include "home_internal.h"
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 const char *home_strerror(int status)
@@ -36,6 +37,16 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->threshold_start = 64.0f;
     cfg->threshold_final = 1.0f;
     cfg->min_inliers = 20;
+    cfg->simd = HOME_SIMD_AUTO;
+    cfg->hough_method = HOME_HOUGH_FAST;
+#ifndef HOME_NO_GETENV
+    {
+        const char *env = getenv("HOME_SIMD");
+        if (env && !strcmp(env, "none")) cfg->simd = HOME_SIMD_NONE;
+        else if (env && !strcmp(env, "sse")) cfg->simd = HOME_SIMD_SSE;
+        else if (env && !strcmp(env, "neon")) cfg->simd = HOME_SIMD_NEON;
+    }
+#endif
     if (width < HOME_MIN_SIDE || height < HOME_MIN_SIDE || width > HOME_MAX_SIDE ||
         height > HOME_MAX_SIDE)
         return HOME_E_SIZE;
@@ -87,6 +98,9 @@ int home_validate_config(const home_config *cfg)
         return HOME_E_CONFIG;
     if (cfg->min_inliers < 4 || cfg->min_inliers > 2 * HOME_MAX_KEYPOINTS_PER_SIGN)
         return HOME_E_CONFIG;
+    if (!home__kernels_for(cfg->simd)) return HOME_E_CONFIG; /* unknown or not compiled in */
+    if (cfg->hough_method != HOME_HOUGH_FAST && cfg->hough_method != HOME_HOUGH_EXACT)
+        return HOME_E_CONFIG;
     return HOME_OK;
 }
 
@@ -112,6 +126,8 @@ uint32_t home__config_id(const home_config *cfg)
 #define BLOCK_ALIGN 64u
 
 typedef struct layout {
+    size_t img_n, img_t, shift, row_lo, row_hi, first_row, line_sum, edge_prefix, line_j;
+    ptrdiff_t img_n_stride, img_t_stride;
     size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, matches,
         inliers, slots, total;
     int max_matches;
@@ -131,9 +147,28 @@ static void plan(const home_config *cfg, layout *l)
     size_t radius = (size_t)ceil(3.0 * cfg->smooth_sigma);
     /* every query keypoint, in primary and (near the wrap) alternate form, yields <= 1 match */
     l->max_matches = 4 * cfg->keypoints_per_sign;
+    size_t w = (size_t)cfg->width, h = (size_t)cfg->height, longest = w > h ? w : h;
+    /* intercepts of one theta row: the other side + both shear extents + derivative + a block */
+    size_t intercepts = w + h + 8 + 2 * HOME__RADON_BLOCK;
     l->ctx = take(&cur, sizeof(home_context));
-    l->grad_x = take(&cur, pixels * sizeof(int16_t));
-    l->grad_y = take(&cur, pixels * sizeof(int16_t));
+    memset(&l->img_n, 0, 9 * sizeof(size_t));
+    l->grad_x = l->grad_y = 0;
+    if (cfg->hough_method == HOME_HOUGH_EXACT) {
+        l->grad_x = take(&cur, pixels * sizeof(int16_t));
+        l->grad_y = take(&cur, pixels * sizeof(int16_t));
+    } else {
+        l->img_n_stride = (ptrdiff_t)(w + 2 * HOME__RADON_BLOCK);
+        l->img_t_stride = (ptrdiff_t)(h + 2 * HOME__RADON_BLOCK);
+        l->img_n = take(&cur, h * (size_t)l->img_n_stride);
+        l->img_t = take(&cur, w * (size_t)l->img_t_stride);
+        l->shift = take(&cur, longest * sizeof(int16_t));
+        l->row_lo = take(&cur, (intercepts / HOME__RADON_BLOCK + 1) * sizeof(int16_t));
+        l->row_hi = take(&cur, (intercepts / HOME__RADON_BLOCK + 1) * sizeof(int16_t));
+        l->first_row = take(&cur, (longest + 4) * sizeof(int32_t));
+        l->line_sum = take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(int32_t));
+        l->edge_prefix = take(&cur, 2 * (longest + 1) * sizeof(int32_t));
+        l->line_j = take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(float));
+    }
     l->acc_x = take(&cur, r_bins * sizeof(int32_t));
     l->acc_y = take(&cur, r_bins * sizeof(int32_t));
     l->raw_rows = take(&cur, (2 * radius + 1) * r_bins * sizeof(float));
@@ -179,8 +214,23 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
     ctx->cfg.r_bins = ctx->r_bins;
     ctx->config_id = home__config_id(&ctx->cfg);
     ctx->smooth_radius = home__gauss_taps(cfg->smooth_sigma, ctx->smooth_taps);
-    ctx->grad_x = (int16_t *)(void *)(base + l.grad_x);
-    ctx->grad_y = (int16_t *)(void *)(base + l.grad_y);
+    ctx->kernels = home__kernels_for(cfg->simd);
+    if (cfg->hough_method == HOME_HOUGH_EXACT) {
+        ctx->grad_x = (int16_t *)(void *)(base + l.grad_x);
+        ctx->grad_y = (int16_t *)(void *)(base + l.grad_y);
+    } else {
+        ctx->img_n = base + l.img_n;
+        ctx->img_t = base + l.img_t;
+        ctx->img_n_stride = l.img_n_stride;
+        ctx->img_t_stride = l.img_t_stride;
+        ctx->shift = (int16_t *)(void *)(base + l.shift);
+        ctx->row_lo = (int16_t *)(void *)(base + l.row_lo);
+        ctx->row_hi = (int16_t *)(void *)(base + l.row_hi);
+        ctx->first_row = (int32_t *)(void *)(base + l.first_row);
+        ctx->line_sum = (int32_t *)(void *)(base + l.line_sum);
+        ctx->edge_prefix = (int32_t *)(void *)(base + l.edge_prefix);
+        ctx->line_j = (float *)(void *)(base + l.line_j);
+    }
     ctx->acc_x = (int32_t *)(void *)(base + l.acc_x);
     ctx->acc_y = (int32_t *)(void *)(base + l.acc_y);
     ctx->raw_rows = (float *)(void *)(base + l.raw_rows);
@@ -204,6 +254,14 @@ int home__check_image(const home_context *ctx, const uint8_t *image, ptrdiff_t s
     if (!image) return HOME_E_NULL;
     if (stride < (ptrdiff_t)ctx->cfg.width) return HOME_E_STRIDE;
     return HOME_OK;
+}
+
+const char *home_simd_backend(const home_context *ctx)
+{
+    const home__kernels *k;
+    if (ctx && ctx->magic == HOME__MAGIC_CTX) return ctx->kernels->name;
+    k = home__kernels_for(HOME_SIMD_AUTO);
+    return k->name;
 }
 
 double home__now(const home_context *ctx)

@@ -3,6 +3,7 @@
 #define HOME_INTERNAL_H
 
 #include "home.h"
+#include "kernels.h"
 
 #define HOME__MAGIC_CTX 0x484f4d43u   /* "HOMC" */
 #define HOME__MAGIC_FEAT 0x484f4d46u  /* "HOMF" */
@@ -41,8 +42,17 @@ struct home_context {
     int r_bins;
     int smooth_radius;
     float smooth_taps[2 * HOME__MAX_SMOOTH_RADIUS + 1];
+    const home__kernels *kernels;     /* SIMD backend */
     /* arena-backed buffers */
-    int16_t *grad_x, *grad_y;         /* width x height, central differences, 0 on the border */
+    int16_t *grad_x, *grad_y;         /* EXACT: width x height central differences, 0 on the border */
+    uint8_t *img_n, *img_t;           /* FAST: the image and its transpose, zero-padded by
+                                         HOME__RADON_BLOCK columns on each side */
+    ptrdiff_t img_n_stride, img_t_stride;
+    int16_t *shift, *row_lo, *row_hi; /* FAST: per-row shear, per-block row ranges */
+    int32_t *first_row;               /* FAST: first row whose shift reaches a value */
+    int32_t *line_sum;                /* FAST: line sums over the intercept range */
+    int32_t *edge_prefix;             /* FAST: prefix sums of the first and last column */
+    float *line_j;                    /* FAST: J over the intercept range */
     int32_t *acc_x, *acc_y;           /* r_bins: line sums of one theta row */
     float *raw_rows;                  /* ring of (2*radius+1) r-smoothed rows */
     float *smooth_rows;               /* ring of HOME__DESC_ROWS fully smoothed rows */

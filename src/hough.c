@@ -1,10 +1,22 @@
 /* Texture-preserving Hough transform J(theta, r) = [sum of grad I along the line] . n(theta),
- * with nearest-bin line summation, then Gaussian smoothing.
+ * with nearest-pixel line summation, then Gaussian smoothing.
  *
- * Since n(theta) is constant along a line, J = cos(theta) R[Ix] + sin(theta) R[Iy], where R sums
- * the exact integer gradients of the pixels whose centre falls in the r bin. The bin index is
- * computed in Q16 fixed point over doubled centred coordinates (integers), so every backend
- * produces the same bins. */
+ * EXACT (the paper's definition, the reference): since n(theta) is constant along a line,
+ * J = cos(theta) R[Ix] + sin(theta) R[Iy], where R sums the exact integer gradients of the pixels
+ * whose centre falls in the r bin (Q16 fixed-point bin index, so the bins are exact integers).
+ *
+ * FAST: for lines within 45 degrees of the columns (the rows of the transposed image for the
+ * others), parametrise a line by its intercept j on the centre row and a slope t; row p holds
+ * the line at column j + round(t (p - centre)). Integer line sums S(j) of the image itself over
+ * such digital lines are a shear-and-add (contiguous SIMD adds, port/). Along a digital line,
+ *   sum of Ix = S(j+1) - S(j-1)                (exactly, by shifting)
+ *   sum of Iy = [I](entry..exit) - t sum of Ix (telescoping: d/dp I(line) = t Ix + Iy)
+ * so J = (1/|a|) ((S(j+1) - S(j-1)) / a + 2 b [I]) with (a, b) = (cos, sin) or (sin, cos), where
+ * 1/|a| turns the per-row sum into a line integral. Pixels beyond the image are taken as the
+ * replicated border (zero gradient across the border, computed in closed form from prefix sums
+ * of the border columns, not read), and [I] is taken between the line's real entry and exit
+ * pixels, so the image frame creates no features. J is then resampled from the intercept grid
+ * (spacing |a| px in r) to the uniform r axis by linear interpolation. */
 #include "home_internal.h"
 #include <math.h>
 #include <string.h>
@@ -29,6 +41,117 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
     }
 }
 
+/* Copy the image into the zero-padded buffers (HOME__RADON_BLOCK columns each side) used by
+ * the shear-and-add kernel: img_n as is, img_t transposed. */
+static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
+{
+    const int width = ctx->cfg.width, height = ctx->cfg.height, pad = HOME__RADON_BLOCK;
+    int x, y;
+    for (y = 0; y < height; y++) {
+        uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
+        memset(row, 0, (size_t)pad);
+        memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
+        memset(row + pad + width, 0, (size_t)pad);
+    }
+    for (x = 0; x < width; x++) {
+        uint8_t *row = ctx->img_t + (ptrdiff_t)x * ctx->img_t_stride;
+        memset(row, 0, (size_t)pad);
+        memset(row + pad + height, 0, (size_t)pad);
+    }
+    for (y = 0; y < height; y++) {       /* transpose in 8-row strips for cache locality */
+        const uint8_t *src = image + (ptrdiff_t)y * stride;
+        uint8_t *dst = ctx->img_t + pad + y;
+        for (x = 0; x < width; x++) dst[(ptrdiff_t)x * ctx->img_t_stride] = src[x];
+    }
+}
+
+/* first row (in processing order) whose shift is >= v; shifts are nondecreasing */
+static int first_row_at(const home_context *ctx, int v, int s_min, int s_max, int rows)
+{
+    if (v <= s_min) return 0;
+    if (v > s_max) return rows;
+    return ctx->first_row[v - s_min];
+}
+
+/* One theta row of J, unsmoothed, on the uniform r axis. */
+static void fast_theta_row(home_context *ctx, double theta, float *out)
+{
+    const double c = cos(theta), s = sin(theta);
+    const int vertical = fabs(c) >= fabs(s);
+    const int rows = vertical ? ctx->cfg.height : ctx->cfg.width;
+    const int cols = vertical ? ctx->cfg.width : ctx->cfg.height;
+    const ptrdiff_t img_stride = vertical ? ctx->img_n_stride : ctx->img_t_stride;
+    const uint8_t *img = (vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK; /* column 0 */
+    const double a = vertical ? c : s, b = vertical ? s : c, t = -b / a;
+    const int flip = t < 0.0; /* process rows so that shifts are nondecreasing */
+    const uint8_t *base = flip ? img + (ptrdiff_t)(rows - 1) * img_stride : img;
+    const ptrdiff_t stride = flip ? -img_stride : img_stride;
+    const double centre = 0.5 * (rows - 1), inv_abs_a = 1.0 / fabs(a);
+    int32_t *left = ctx->edge_prefix, *right = ctx->edge_prefix + rows + 1;
+    int32_t *sum = ctx->line_sum;
+    float *line = ctx->line_j;
+    int p, v, j, s_min, s_max, j0, n, n_blocks, blk, i;
+
+    for (p = 0; p < rows; p++) {
+        double pc = (flip ? rows - 1 - p : p) - centre;
+        ctx->shift[p] = (int16_t)floor(t * pc + 0.5);
+    }
+    s_min = ctx->shift[0];
+    s_max = ctx->shift[rows - 1];
+    for (p = 0, v = s_min + 1; v <= s_max; v++) {
+        while (ctx->shift[p] < v) p++;
+        ctx->first_row[v - s_min] = p;
+    }
+    /* intercepts of every line touching the image, plus one on each side for S(j +- 1) */
+    j0 = -s_max - 1;
+    n = cols - s_min - j0 + 1;
+    n_blocks = (n + HOME__RADON_BLOCK - 1) / HOME__RADON_BLOCK;
+    for (blk = 0; blk < n_blocks; blk++) {
+        int jb = j0 + blk * HOME__RADON_BLOCK;
+        ctx->row_lo[blk] = (int16_t)first_row_at(ctx, -jb - (HOME__RADON_BLOCK - 1), s_min, s_max, rows);
+        ctx->row_hi[blk] = (int16_t)(first_row_at(ctx, cols - jb, s_min, s_max, rows) - 1);
+    }
+    ctx->kernels->radon_blocks(base, stride, ctx->shift, j0, n_blocks, ctx->row_lo, ctx->row_hi, sum);
+
+    /* prefix sums of the first and last column in processing order (the replicated border) */
+    left[0] = right[0] = 0;
+    for (p = 0; p < rows; p++) {
+        const uint8_t *row = base + (ptrdiff_t)p * stride;
+        left[p + 1] = left[p] + row[0];
+        right[p + 1] = right[p] + row[cols - 1];
+    }
+    for (i = 0; i < n; i++) {
+        int entry, after;
+        j = j0 + i;
+        entry = first_row_at(ctx, -j, s_min, s_max, rows);   /* rows before: left of the image */
+        after = first_row_at(ctx, cols - j, s_min, s_max, rows); /* rows from here: right of it */
+        sum[i] += left[entry] + right[rows] - right[after];
+        if (entry < after) {
+            int first_value = base[(ptrdiff_t)entry * stride + j + ctx->shift[entry]];
+            int last_value = base[(ptrdiff_t)(after - 1) * stride + j + ctx->shift[after - 1]];
+            /* [I] between the line's ends, in increasing original row order */
+            line[i] = (float)(2.0 * b * (flip ? first_value - last_value : last_value - first_value));
+        } else {
+            line[i] = 0.0f;
+        }
+    }
+    /* J on the intercept grid (in place over the end terms), then resampled to the r axis */
+    for (i = 1; i < n - 1; i++)
+        line[i] = (float)(inv_abs_a * ((double)(sum[i + 1] - sum[i - 1]) / a + line[i]));
+    line[0] = line[n - 1] = 0.0f;
+    {
+        const double r_centre = 0.5 * (ctx->r_bins - 1), step = ctx->cfg.r_step;
+        const double j_offset = 0.5 * (cols - 1) - j0;
+        for (i = 0; i < ctx->r_bins; i++) {
+            double jf = (i - r_centre) * step / a + j_offset, f;
+            int k = (int)floor(jf);
+            if (k < 0 || k >= n - 1) { out[i] = 0.0f; continue; }
+            f = jf - k;
+            out[i] = (float)((1.0 - f) * line[k] + f * line[k + 1]);
+        }
+    }
+}
+
 double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t stride,
                           home__row_fn on_row, void *user)
 {
@@ -44,16 +167,24 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
     double t0 = home__now(ctx), spent = 0.0;
     int k, i;
 
-    home__gradient(image, stride, width, height, ctx->grad_x, ctx->grad_y);
+    const int exact = ctx->cfg.hough_method == HOME_HOUGH_EXACT;
+    if (exact)
+        home__gradient(image, stride, width, height, ctx->grad_x, ctx->grad_y);
+    else
+        prepare_fast(ctx, image, stride);
     for (k = first_raw; k <= last_raw; k++) {
         double theta = k * HOME__PI / n_theta, c = cos(theta), s = sin(theta);
         float *raw = ctx->raw_rows + (size_t)((k - first_raw) % raw_ring) * r_bins;
         int j;
-        home__hough_accumulate_row(ctx->grad_x, ctx->grad_y, width, height,
-                                   (int32_t)lround(c * scale), (int32_t)lround(s * scale), base_q,
-                                   ctx->acc_x, ctx->acc_y, r_bins);
-        for (i = 0; i < r_bins; i++)
-            ctx->row_tmp[i] = (float)(c * ctx->acc_x[i] + s * ctx->acc_y[i]);
+        if (exact) {
+            home__hough_accumulate_row(ctx->grad_x, ctx->grad_y, width, height,
+                                       (int32_t)lround(c * scale), (int32_t)lround(s * scale),
+                                       base_q, ctx->acc_x, ctx->acc_y, r_bins);
+            for (i = 0; i < r_bins; i++)
+                ctx->row_tmp[i] = (float)(c * ctx->acc_x[i] + s * ctx->acc_y[i]);
+        } else {
+            fast_theta_row(ctx, theta, ctx->row_tmp);
+        }
         home__smooth_r(ctx->row_tmp, raw, r_bins, ctx->smooth_taps, radius);
         if (k - first_raw < 2 * radius) continue;
 

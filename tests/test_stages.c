@@ -194,7 +194,7 @@ void test_descriptor_invariance(void)
                 double d = fabs(feat_b.kp[j].theta - tb) * 480 / HOME__PI + fabs(feat_b.kp[j].r - rb);
                 if (feat_b.kp[j].sign == ka->sign && d < best) best = d, jb = j;
             }
-            CHECK_LT(best, 0.5);
+            CHECK_LT(best, 0.75); /* theta bins + r px */
             if (jb < 0) continue;
             for (k = 0; k < HOME_DESC_LEN; k++) sad += abs(ka->desc[k] - feat_b.kp[jb].desc[k]);
             if (sad > worst) worst = sad;

@@ -1,0 +1,39 @@
+/* libhome's hot kernels: one table per SIMD backend, chosen per context at home_init().
+ * Every backend must produce bit-identical results to the scalar reference (integer kernels),
+ * which tests/test_kernels.c checks on odd sizes, unaligned pointers and extreme inputs. */
+#ifndef HOME_KERNELS_H
+#define HOME_KERNELS_H
+#include <stddef.h>
+#include <stdint.h>
+
+/* Lanes per block of the shear-and-add Radon kernel. */
+#define HOME__RADON_BLOCK 64
+/* Rows summed in 16-bit lanes before widening: 128 * 255 = 32640 fits int16. */
+#define HOME__RADON_ROWS_16BIT 128
+
+typedef struct home__kernels {
+    const char *name;
+    /* Shear-and-add line sums for n_blocks blocks of HOME__RADON_BLOCK intercepts:
+     *   out[b*64 + l] = sum over rows p in [row_lo[b], row_hi[b]] of
+     *                   base[p*stride + j0 + b*64 + l + shift[p]]
+     * (an empty range when row_lo[b] > row_hi[b]). base may be read 64 bytes beyond each row's
+     * in-image columns on both sides; stride may be negative. */
+    void (*radon_blocks)(const uint8_t *base, ptrdiff_t stride, const int16_t *shift, int j0,
+                         int n_blocks, const int16_t *row_lo, const int16_t *row_hi,
+                         int32_t *out);
+} home__kernels;
+
+extern const home__kernels home__kernels_scalar;
+#if defined(__SSE2__)
+#define HOME__HAVE_SSE 1
+extern const home__kernels home__kernels_sse;
+#endif
+#if defined(__ARM_NEON) || defined(__ARM_NEON__)
+#define HOME__HAVE_NEON 1
+extern const home__kernels home__kernels_neon;
+#endif
+
+/* The table for a home_simd value (HOME_SIMD_AUTO picks the best compiled in), or NULL when
+ * that backend is not compiled into this build. */
+const home__kernels *home__kernels_for(int simd);
+#endif
