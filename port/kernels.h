@@ -8,6 +8,8 @@
 
 /* Lanes per block of the shear-and-add Radon kernel. */
 #define HOME__RADON_BLOCK 64
+/* Largest Gaussian radius the smoothing kernels accept. */
+#define HOME__MAX_TAPS_RADIUS 8
 /* Rows summed in 16-bit lanes before widening: 128 * 255 = 32640 fits int16. */
 #define HOME__RADON_ROWS_16BIT 128
 
@@ -21,6 +23,17 @@ typedef struct home__kernels {
     void (*radon_blocks)(const uint8_t *base, ptrdiff_t stride, const int16_t *shift, int j0,
                          int n_blocks, const int16_t *row_lo, const int16_t *row_hi,
                          int32_t *out);
+    /* L1 distances of a 16-byte query to n descriptors `stride` bytes apart: the index of the
+     * nearest (lowest index on ties), its distance d1 and the second smallest distance d2
+     * (1 << 30 when absent). */
+    void (*nearest2_l1)(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
+                        int *best, int *d1, int *d2);
+    /* out[i] = sum_k taps[k] * in[i - radius + k] (k = 0 .. 2 radius, in this order), for i in
+     * [radius, n - radius): the interior of a row; callers handle the borders. */
+    void (*smooth_row)(const float *in, float *out, int n, const float *taps, int radius);
+    /* out[i] = sum_k taps[k] * rows[k][i] (k = 0 .. 2 radius, in this order), i in [0, n). */
+    void (*smooth_cols)(const float *const *rows, float *out, int n, const float *taps,
+                        int radius);
 } home__kernels;
 
 extern const home__kernels home__kernels_scalar;

@@ -35,7 +35,54 @@ static void radon_blocks_neon(const uint8_t *base, ptrdiff_t stride, const int16
     }
 }
 
-const home__kernels home__kernels_neon = {"neon", radon_blocks_neon};
+static void nearest2_l1_neon(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
+                             int *best, int *d1, int *d2)
+{
+    const uint8x16_t q = vld1q_u8(query);
+    int j, b = -1, m1 = 1 << 30, m2 = 1 << 30;
+    for (j = 0; j < n; j++) {
+        uint8x16_t diff = vabdq_u8(q, vld1q_u8(cands + (ptrdiff_t)j * stride));
+        uint64x2_t s = vpaddlq_u32(vpaddlq_u16(vpaddlq_u8(diff)));
+        int d = (int)(vgetq_lane_u64(s, 0) + vgetq_lane_u64(s, 1));
+        if (d < m1) { m2 = m1; m1 = d; b = j; }
+        else if (d < m2) m2 = d;
+    }
+    *best = b; *d1 = m1; *d2 = m2;
+}
+
+/* vmulq then vaddq (never a fused multiply-add): the same rounding as the scalar reference. */
+static void smooth_row_neon(const float *in, float *out, int n, const float *taps, int radius)
+{
+    int i = radius, k;
+    for (; i + 4 <= n - radius; i += 4) {
+        float32x4_t acc = vdupq_n_f32(0.0f);
+        for (k = 0; k <= 2 * radius; k++)
+            acc = vaddq_f32(acc, vmulq_f32(vdupq_n_f32(taps[k]), vld1q_f32(in + i - radius + k)));
+        vst1q_f32(out + i, acc);
+    }
+    /* the last < 4 outputs by the reference, on a window that starts at output i */
+    home__kernels_scalar.smooth_row(in + i - radius, out + i - radius, n - i + radius, taps, radius);
+}
+
+static void smooth_cols_neon(const float *const *rows, float *out, int n, const float *taps,
+                             int radius)
+{
+    int i = 0, k;
+    for (; i + 4 <= n; i += 4) {
+        float32x4_t acc = vdupq_n_f32(0.0f);
+        for (k = 0; k <= 2 * radius; k++)
+            acc = vaddq_f32(acc, vmulq_f32(vdupq_n_f32(taps[k]), vld1q_f32(rows[k] + i)));
+        vst1q_f32(out + i, acc);
+    }
+    if (i < n) {
+        const float *tail[2 * HOME__MAX_TAPS_RADIUS + 1];
+        for (k = 0; k <= 2 * radius; k++) tail[k] = rows[k] + i;
+        home__kernels_scalar.smooth_cols(tail, out + i, n - i, taps, radius);
+    }
+}
+
+const home__kernels home__kernels_neon = {"neon", radon_blocks_neon, nearest2_l1_neon,
+                                          smooth_row_neon, smooth_cols_neon};
 #else
 typedef int home__neon_unavailable; /* ISO C forbids an empty translation unit */
 #endif

@@ -17,4 +17,40 @@ static void radon_blocks_scalar(const uint8_t *base, ptrdiff_t stride, const int
     }
 }
 
-const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar};
+static void nearest2_l1_scalar(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride,
+                               int n, int *best, int *d1, int *d2)
+{
+    int j, k, b = -1, m1 = 1 << 30, m2 = 1 << 30;
+    for (j = 0; j < n; j++) {
+        const uint8_t *c = cands + (ptrdiff_t)j * stride;
+        int d = 0;
+        for (k = 0; k < 16; k++) d += query[k] > c[k] ? query[k] - c[k] : c[k] - query[k];
+        if (d < m1) { m2 = m1; m1 = d; b = j; }
+        else if (d < m2) m2 = d;
+    }
+    *best = b; *d1 = m1; *d2 = m2;
+}
+
+static void smooth_row_scalar(const float *in, float *out, int n, const float *taps, int radius)
+{
+    int i, k;
+    for (i = radius; i < n - radius; i++) {
+        float acc = 0.0f;
+        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * in[i - radius + k];
+        out[i] = acc;
+    }
+}
+
+static void smooth_cols_scalar(const float *const *rows, float *out, int n, const float *taps,
+                               int radius)
+{
+    int i, k;
+    for (i = 0; i < n; i++) {
+        float acc = 0.0f;
+        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * rows[k][i];
+        out[i] = acc;
+    }
+}
+
+const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
+                                            smooth_row_scalar, smooth_cols_scalar};

@@ -36,7 +36,54 @@ static void radon_blocks_sse(const uint8_t *base, ptrdiff_t stride, const int16_
     }
 }
 
-const home__kernels home__kernels_sse = {"sse", radon_blocks_sse};
+static void nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
+                            int *best, int *d1, int *d2)
+{
+    const __m128i q = _mm_loadu_si128((const __m128i *)(const void *)query);
+    int j, b = -1, m1 = 1 << 30, m2 = 1 << 30;
+    for (j = 0; j < n; j++) {
+        __m128i c = _mm_loadu_si128((const __m128i *)(const void *)(cands + (ptrdiff_t)j * stride));
+        __m128i sad = _mm_sad_epu8(q, c);  /* two 64-bit partial sums */
+        int d = _mm_cvtsi128_si32(_mm_add_epi32(sad, _mm_srli_si128(sad, 8)));
+        if (d < m1) { m2 = m1; m1 = d; b = j; }
+        else if (d < m2) m2 = d;
+    }
+    *best = b; *d1 = m1; *d2 = m2;
+}
+
+/* Same multiply-then-add order as the scalar reference, 4 outputs at a time: bit-identical. */
+static void smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius)
+{
+    int i = radius, k;
+    for (; i + 4 <= n - radius; i += 4) {
+        __m128 acc = _mm_setzero_ps();
+        for (k = 0; k <= 2 * radius; k++)
+            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(taps[k]), _mm_loadu_ps(in + i - radius + k)));
+        _mm_storeu_ps(out + i, acc);
+    }
+    /* the last < 4 outputs by the reference, on a window that starts at output i */
+    home__kernels_scalar.smooth_row(in + i - radius, out + i - radius, n - i + radius, taps, radius);
+}
+
+static void smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
+                            int radius)
+{
+    int i = 0, k;
+    for (; i + 4 <= n; i += 4) {
+        __m128 acc = _mm_setzero_ps();
+        for (k = 0; k <= 2 * radius; k++)
+            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(taps[k]), _mm_loadu_ps(rows[k] + i)));
+        _mm_storeu_ps(out + i, acc);
+    }
+    if (i < n) {
+        const float *tail[2 * HOME__MAX_TAPS_RADIUS + 1];
+        for (k = 0; k <= 2 * radius; k++) tail[k] = rows[k] + i;
+        home__kernels_scalar.smooth_cols(tail, out + i, n - i, taps, radius);
+    }
+}
+
+const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, nearest2_l1_sse, smooth_row_sse,
+                                         smooth_cols_sse};
 #else
 typedef int home__sse_unavailable; /* ISO C forbids an empty translation unit */
 #endif

@@ -8,7 +8,7 @@
 #define HOME__MAGIC_CTX 0x484f4d43u   /* "HOMC" */
 #define HOME__MAGIC_FEAT 0x484f4d46u  /* "HOMF" */
 #define HOME__PI 3.14159265358979323846
-#define HOME__MAX_SMOOTH_RADIUS 8     /* sigma <= 2.6 bins */
+#define HOME__MAX_SMOOTH_RADIUS HOME__MAX_TAPS_RADIUS /* sigma <= 2.6 bins */
 #define HOME__DESC_ROWS 5             /* smoothed rows kept: detection (3) + descriptor (+-2) */
 
 /* A keypoint candidate while the top-K heaps are filled. samples are the raw (float)
@@ -90,9 +90,8 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
 
 /* smooth.c */
 int home__gauss_taps(float sigma, float *taps);
-void home__smooth_r(const float *in, float *out, int n, const float *taps, int radius);
-void home__smooth_theta(const float *const *rows, float *out, int n, const float *taps,
-                        int radius);
+void home__smooth_r(const home__kernels *kernels, const float *in, float *out, int n,
+                    const float *taps, int radius);
 
 /* extrema.c */
 void home__heap_init(home__heap *heap, home__candidate *storage, int capacity);

@@ -136,16 +136,21 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
         }
     }
     /* J on the intercept grid (in place over the end terms), then resampled to the r axis */
-    for (i = 1; i < n - 1; i++)
-        line[i] = (float)(inv_abs_a * ((double)(sum[i + 1] - sum[i - 1]) / a + line[i]));
-    line[0] = line[n - 1] = 0.0f;
     {
-        const double r_centre = 0.5 * (ctx->r_bins - 1), step = ctx->cfg.r_step;
-        const double j_offset = 0.5 * (cols - 1) - j0;
+        const double d_scale = inv_abs_a / a;
+        for (i = 1; i < n - 1; i++)
+            line[i] = (float)(d_scale * (double)(sum[i + 1] - sum[i - 1]) + inv_abs_a * line[i]);
+        line[0] = line[n - 1] = 0.0f;
+    }
+    {
+        /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0 */
+        const double dj = ctx->cfg.r_step / a;
+        const double jf0 = -0.5 * (ctx->r_bins - 1) * dj + 0.5 * (cols - 1) - j0;
         for (i = 0; i < ctx->r_bins; i++) {
-            double jf = (i - r_centre) * step / a + j_offset, f;
-            int k = (int)floor(jf);
-            if (k < 0 || k >= n - 1) { out[i] = 0.0f; continue; }
+            double jf = jf0 + i * dj, f;
+            int k;
+            if (!(jf >= 0.0) || jf >= (double)(n - 1)) { out[i] = 0.0f; continue; }
+            k = (int)jf; /* jf >= 0: truncation is floor */
             f = jf - k;
             out[i] = (float)((1.0 - f) * line[k] + f * line[k + 1]);
         }
@@ -185,13 +190,13 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
         } else {
             fast_theta_row(ctx, theta, ctx->row_tmp);
         }
-        home__smooth_r(ctx->row_tmp, raw, r_bins, ctx->smooth_taps, radius);
+        home__smooth_r(ctx->kernels, ctx->row_tmp, raw, r_bins, ctx->smooth_taps, radius);
         if (k - first_raw < 2 * radius) continue;
 
         j = k - radius; /* the theta-smoothed row now complete */
         for (i = 0; i < raw_ring; i++)
             raw_window[i] = ctx->raw_rows + (size_t)((j - radius + i - first_raw) % raw_ring) * r_bins;
-        home__smooth_theta(raw_window, ctx->smooth_rows +
+        ctx->kernels->smooth_cols(raw_window, ctx->smooth_rows +
                                (size_t)((j - first_smooth) % HOME__DESC_ROWS) * r_bins,
                            r_bins, ctx->smooth_taps, radius);
         for (i = 0; i < HOME__DESC_ROWS; i++) {

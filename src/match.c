@@ -4,24 +4,15 @@
  * wrap between two frames (home-notes.md, finding 4). */
 #include "home_internal.h"
 
-static int l1_distance(const uint8_t *a, const uint8_t *b)
-{
-    int k, d = 0;
-    for (k = 0; k < HOME_DESC_LEN; k++) d += a[k] > b[k] ? a[k] - b[k] : b[k] - a[k];
-    return d;
-}
-
 /* Best candidate in b's keypoints [lo, hi) passing the ratio test, or -1. */
-static int best_match(const uint8_t *desc, const home_features *b, int lo, int hi, float ratio)
+static int best_match(const home__kernels *kernels, const uint8_t *desc, const home_features *b,
+                      int lo, int hi, float ratio)
 {
-    int j, best = -1, d1 = 1 << 30, d2 = 1 << 30;
-    for (j = lo; j < hi; j++) {
-        int d = l1_distance(desc, b->kp[j].desc);
-        if (d < d1) { d2 = d1; d1 = d; best = j; }
-        else if (d < d2) d2 = d;
-    }
-    if (best < 0 || d2 == (1 << 30)) return -1;
-    return (float)d1 < ratio * (float)d2 ? best : -1;
+    int best, d1, d2;
+    if (hi - lo < 2) return -1;
+    kernels->nearest2_l1(desc, b->kp[lo].desc, (ptrdiff_t)sizeof(home_keypoint), hi - lo, &best,
+                         &d1, &d2);
+    return (float)d1 < ratio * (float)d2 ? lo + best : -1;
 }
 
 int home__match_features(home_context *ctx, const home_features *a, const home_features *b)
@@ -32,14 +23,14 @@ int home__match_features(home_context *ctx, const home_features *a, const home_f
         const home_keypoint *q = &a->kp[i];
         int same_lo = q->sign > 0 ? 0 : b->n_pos, same_hi = q->sign > 0 ? b->n_pos : b->n_pos + b->n_neg;
         int opp_lo = q->sign > 0 ? b->n_pos : 0, opp_hi = q->sign > 0 ? b->n_pos + b->n_neg : b->n_pos;
-        int j = best_match(q->desc, b, same_lo, same_hi, ratio);
+        int j = best_match(ctx->kernels, q->desc, b, same_lo, same_hi, ratio);
         if (j >= 0 && n < ctx->max_matches) {
             home__match *m = &ctx->matches[n++];
             m->theta_a = q->theta; m->r_a = q->r;
             m->theta_b = b->kp[j].theta; m->r_b = b->kp[j].r;
         }
         if (!q->has_alt) continue;
-        j = best_match(q->alt_desc, b, opp_lo, opp_hi, ratio);
+        j = best_match(ctx->kernels, q->alt_desc, b, opp_lo, opp_hi, ratio);
         if (j >= 0 && n < ctx->max_matches) {
             home__match *m = &ctx->matches[n++];
             m->theta_a = q->theta < (float)(HOME__PI / 2) ? q->theta + (float)HOME__PI

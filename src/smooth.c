@@ -15,26 +15,19 @@ int home__gauss_taps(float sigma, float *taps)
     return radius;
 }
 
-void home__smooth_r(const float *in, float *out, int n, const float *taps, int radius)
+/* Borders (where taps fall off the r axis) here; the interior through the SIMD kernel. */
+void home__smooth_r(const home__kernels *kernels, const float *in, float *out, int n,
+                    const float *taps, int radius)
 {
     int i, k;
     for (i = 0; i < n; i++) {
         float acc = 0.0f;
-        int lo = i - radius < 0 ? radius - i : 0;
-        int hi = i + radius >= n ? radius + (n - 1 - i) : 2 * radius;
+        int lo, hi;
+        if (i == radius && n > 2 * radius) i = n - radius; /* skip the interior */
+        lo = i - radius < 0 ? radius - i : 0;
+        hi = i + radius >= n ? radius + (n - 1 - i) : 2 * radius;
         for (k = lo; k <= hi; k++) acc += taps[k] * in[i - radius + k];
         out[i] = acc;
     }
-}
-
-/* rows[k] for k in [0, 2 radius] are the r-smoothed rows centre-radius .. centre+radius. */
-void home__smooth_theta(const float *const *rows, float *out, int n, const float *taps,
-                        int radius)
-{
-    int i, k;
-    for (i = 0; i < n; i++) {
-        float acc = 0.0f;
-        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * rows[k][i];
-        out[i] = acc;
-    }
+    if (n > 2 * radius) kernels->smooth_row(in, out, n, taps, radius);
 }
