@@ -8,6 +8,7 @@ ifeq ($(origin AR),default)
 AR := $(CROSS_COMPILE)ar
 endif
 NM ?= $(CROSS_COMPILE)nm
+OBJDUMP ?= $(CROSS_COMPILE)objdump
 PREFIX ?= /usr/local
 BUILD ?= build
 SANITIZE ?=
@@ -70,7 +71,7 @@ $(BUILD)/bin/home-tests: $(TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
 test: all
-	BUILD=$(BUILD) NM="$(NM)" RUNNER="$(RUNNER)" CC="$(CC)" TEST_BINS="$(TEST_BINS)" SANFLAGS="$(if $(SANITIZE),-fsanitize=$(SANITIZE))" bash tests/run.sh
+	BUILD=$(BUILD) NM="$(NM)" OBJDUMP="$(OBJDUMP)" RUNNER="$(RUNNER)" CC="$(CC)" TEST_BINS="$(TEST_BINS)" SANFLAGS="$(if $(SANITIZE),-fsanitize=$(SANITIZE))" bash tests/run.sh
 
 demo: all
 	@mkdir -p $(BUILD)/demo
