@@ -1,0 +1,187 @@
+/* Every compiled SIMD backend against the scalar reference, bit for bit: odd sizes, unaligned
+ * pointers, negative strides, random and extreme inputs; then the whole pipeline per backend. */
+#include "test.h"
+#include "test_util.h"
+#include "home_internal.h"
+#include "synth.h"
+#include <math.h>
+#include <string.h>
+
+static const int backends[] = {HOME_SIMD_SSE, HOME_SIMD_NEON};
+
+static uint8_t random_byte(synth_rng *rng, int extreme)
+{
+    double u = synth_uniform(rng);
+    if (extreme) return u < 0.5 ? 0 : 255;
+    return (uint8_t)(u * 256);
+}
+
+void test_kernels_radon(void)
+{
+    enum { ROWS = 150, COLS = 77, PAD = HOME__RADON_BLOCK, STRIDE = COLS + 2 * PAD + 5 };
+    static uint8_t image[ROWS * STRIDE + 64];
+    static int32_t want[8 * HOME__RADON_BLOCK], got[8 * HOME__RADON_BLOCK];
+    int16_t shift[ROWS], lo[8], hi[8];
+    synth_rng rng;
+    size_t bi;
+    int trial, compared = 0;
+    synth_seed(&rng, 17);
+    for (trial = 0; trial < 40; trial++) {
+        int offset = trial % 4, n_blocks = 1 + trial % 3, b, p, flip = trial & 1;
+        double slope = synth_uniform(&rng);
+        uint8_t *base = image + offset + PAD;
+        const uint8_t *start;
+        ptrdiff_t stride = STRIDE;
+        for (p = 0; p < ROWS * STRIDE; p++) image[offset + p] = random_byte(&rng, trial % 5 == 0);
+        for (p = 0; p < ROWS; p++) shift[p] = (int16_t)((p - ROWS / 2) * slope * 0.5);
+        /* row ranges: full, partial, empty and longer than the 16-bit flush interval */
+        for (b = 0; b < n_blocks; b++) {
+            lo[b] = (int16_t)(b == 1 ? 40 : 0);
+            hi[b] = (int16_t)(b == 2 ? 10 : b == 1 ? 30 : ROWS - 1); /* block 1: empty */
+        }
+        start = flip ? base + (ptrdiff_t)(ROWS - 1) * STRIDE : base;
+        if (flip) stride = -stride;
+        home__kernels_scalar.radon_blocks(start, stride, shift, -20, n_blocks, lo, hi, want);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *k = home__kernels_for(backends[bi]);
+            if (!k) continue;
+            memset(got, 0x55, sizeof got);
+            k->radon_blocks(start, stride, shift, -20, n_blocks, lo, hi, got);
+            CHECK(memcmp(want, got, (size_t)n_blocks * HOME__RADON_BLOCK * sizeof *got) == 0);
+            compared++;
+        }
+    }
+    /* an all-255 column of 150 rows overflows 16 bits unless the kernel widens in time */
+    CHECK(compared == 0 || compared >= 40);
+}
+
+void test_kernels_nearest(void)
+{
+    enum { N = 97, STRIDE = 48 };
+    static uint8_t cands[N * STRIDE + 16], query[17];
+    synth_rng rng;
+    int trial;
+    synth_seed(&rng, 18);
+    for (trial = 0; trial < 60; trial++) {
+        int n = 1 + trial % N, i, wb, wd1, wd2;
+        size_t bi;
+        for (i = 0; i < N * STRIDE; i++) cands[i] = random_byte(&rng, trial % 7 == 0);
+        for (i = 0; i < 17; i++) query[i] = random_byte(&rng, trial % 7 == 0);
+        if (trial % 3 == 0) memcpy(cands + 5 * STRIDE + 1, cands + 2 * STRIDE + 1, 16); /* a tie */
+        home__kernels_scalar.nearest2_l1(query + trial % 2, cands + 1, STRIDE, n, &wb, &wd1, &wd2);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *k = home__kernels_for(backends[bi]);
+            int b, d1, d2;
+            if (!k) continue;
+            k->nearest2_l1(query + trial % 2, cands + 1, STRIDE, n, &b, &d1, &d2);
+            CHECK_EQ_INT(b, wb);
+            CHECK_EQ_INT(d1, wd1);
+            CHECK_EQ_INT(d2, wd2);
+        }
+    }
+}
+
+void test_kernels_smooth(void)
+{
+    enum { N = 203 };
+    static float in[17][N + 1], want[N + 1], got[N + 1];
+    float taps[17];
+    const float *rows[17];
+    synth_rng rng;
+    int trial, i, k;
+    synth_seed(&rng, 19);
+    for (trial = 0; trial < 30; trial++) {
+        int radius = 1 + trial % 8, n = 2 * radius + 1 + (trial * 7) % (N - 2 * radius);
+        int offset = trial % 2;
+        size_t bi;
+        home__gauss_taps(0.4f + 0.33f * (float)radius, taps);
+        for (k = 0; k < 17; k++) {
+            for (i = 0; i <= N; i++)
+                in[k][i] = (float)((synth_uniform(&rng) - 0.5) * (trial % 4 == 0 ? 3e6 : 300.0));
+            rows[k] = in[k] + offset;
+        }
+        memset(want, 0, sizeof want);
+        home__kernels_scalar.smooth_row(in[0] + offset, want, n, taps, radius);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *kr = home__kernels_for(backends[bi]);
+            if (!kr) continue;
+            memset(got, 0, sizeof got);
+            kr->smooth_row(in[0] + offset, got, n, taps, radius);
+            CHECK(memcmp(want, got, sizeof want) == 0);
+        }
+        home__kernels_scalar.smooth_cols(rows, want, n, taps, radius);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *kr = home__kernels_for(backends[bi]);
+            if (!kr) continue;
+            kr->smooth_cols(rows, got, n, taps, radius);
+            CHECK(memcmp(want, got, (size_t)n * sizeof *got) == 0);
+        }
+    }
+}
+
+void test_backends_identical_output(void)
+{
+    /* the whole registration is bit-identical on every compiled backend */
+    enum { W = 320, H = 180 };
+    static uint8_t a[W * H], b[W * H];
+    static home_features ref_a;
+    home_config cfg;
+    home_result ref, res;
+    double h[9], ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    synth_rng rng;
+    size_t bi;
+    home_context *ctx;
+    synth_seed(&rng, 23);
+    synth_corner_homography(&rng, W, H, 12, h);
+    synth_render(SYNTH_STRUCTURED, 23, ident, 2.5, 1, a, W, H, W);
+    synth_render(SYNTH_STRUCTURED, 23, h, 2.5, 2, b, W, H, W);
+    home_default_config(&cfg, W, H);
+    cfg.simd = HOME_SIMD_NONE;
+    ctx = test_context(W, H, &cfg);
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_register(ctx, a, W, b, W, &ref), HOME_OK);
+    CHECK(ref.ok);
+    memcpy(&ref_a, home_last_features(ctx, 0), sizeof ref_a);
+    for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+        cfg.simd = backends[bi];
+        if (!home__kernels_for(cfg.simd)) continue;
+        ctx = test_context(W, H, &cfg);
+        if (!ctx) { CHECK(0); continue; }
+        CHECK(strcmp(home_simd_backend(ctx), "none") != 0);
+        CHECK_EQ_INT(home_register(ctx, a, W, b, W, &res), HOME_OK);
+        CHECK(memcmp(ref.H, res.H, sizeof ref.H) == 0);
+        CHECK_EQ_INT(res.matches, ref.matches);
+        CHECK(memcmp(ref_a.kp, home_last_features(ctx, 0)->kp, sizeof ref_a.kp) == 0);
+    }
+}
+
+void test_fast_hough_matches_exact(void)
+{
+    /* the fast transform finds the same lines as the paper's pixel-by-pixel definition */
+    enum { W = 320, H = 180 };
+    static uint8_t img[W * H];
+    static home_features fast, exact;
+    home_config cfg;
+    double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int i, j, found = 0;
+    home_context *ctx;
+    synth_render(SYNTH_STRUCTURED, 5, ident, 2.5, 1, img, W, H, W);
+    home_default_config(&cfg, W, H);
+    cfg.hough_method = HOME_HOUGH_EXACT;
+    ctx = test_context(W, H, &cfg);
+    CHECK_EQ_INT(home_extract(ctx, img, W, &exact), HOME_OK);
+    cfg.hough_method = HOME_HOUGH_FAST;
+    ctx = test_context(W, H, &cfg);
+    CHECK_EQ_INT(home_extract(ctx, img, W, &fast), HOME_OK);
+    /* the 40 most salient lines of each sign of the exact transform reappear within 0.3 bin */
+    for (i = 0; i < 80; i++) {
+        const home_keypoint *e = &exact.kp[i < 40 ? i : exact.n_pos + i - 40];
+        for (j = 0; j < fast.n_pos + fast.n_neg; j++) {
+            const home_keypoint *f = &fast.kp[j];
+            if (f->sign == e->sign && fabsf(f->r - e->r) < 0.3f &&
+                fabsf(f->theta - e->theta) < 0.3f * 3.14159265f / 480) { found++; break; }
+        }
+    }
+    printf("     %d of 80 strongest exact-transform keypoints found by the fast transform\n", found);
+    CHECK(found >= 64);
+}
