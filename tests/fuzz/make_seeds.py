@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""Write the hand-made part of the seed corpus (tests/fuzz/corpus/<target>/seed-*): inputs that
+reach each harness's deep paths at once. The rest of the corpus is what `make fuzz` found,
+minimised with libFuzzer's -merge=1. Deterministic; run from the repository root."""
+import random
+import struct
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent / "corpus"
+
+
+def u16(v):
+    return struct.pack("<H", v & 0xFFFF)
+
+
+def api_seed(rng, flags, side=48, theta=40, shapes=10, shift=(3, -2)):
+    """fuzz_api.c layout: flags, sizes, theta/keypoints/min-inliers, image recipe, shift."""
+    b = u16(flags)
+    b += u16(side - 32) + u16(side - 32)          # width, height = 32 + v % 25
+    b += u16(theta - 16) + u16(120 - 8) + u16(8)  # theta bins, keypoints 120, min inliers 12
+    if flags & 0x08:                              # FLAG_STRIDE: padded rows for a and b
+        b += u16(5 + 2) + bytes([0]) + u16(3)
+    b += bytes([1, rng.randrange(40, 90)]) + u16(3) + u16(3) + u16(shapes)  # shapes on a flat base
+    for _ in range(shapes):
+        x0, y0 = rng.randrange(side - 8), rng.randrange(side - 8)
+        b += u16(x0) + u16(y0) + u16(rng.randrange(4, 20)) + u16(rng.randrange(4, 20))
+        b += bytes([rng.randrange(256)])
+    b += u16(shift[0] + 6) + u16(shift[1] + 6) + u16(0)
+    return b
+
+
+def main():
+    rng = random.Random(7)
+    api = ROOT / "api"
+    api.mkdir(parents=True, exist_ok=True)
+    seeds = {
+        "pair": api_seed(rng, 0x000),
+        "video": api_seed(rng, 0x100),
+        "video-clock": api_seed(rng, 0x300),
+        "strides": api_seed(rng, 0x108),
+        "render": api_seed(rng, 0x020),
+        "corrupt": api_seed(rng, 0x040) + bytes([4]) + bytes(rng.randrange(256) for _ in range(64)),
+        "independent": api_seed(rng, 0x010) + bytes([0]) + bytes(rng.randrange(256) for _ in range(200)),
+        "large-shift": api_seed(rng, 0x100, side=56, theta=48, shapes=12, shift=(6, 5)),
+        "misaligned": u16(0x002) + bytes(12) + u16(7),
+        "arena-short": u16(0x004) + bytes(12) + u16(100),
+        "raw-size": u16(0x080) + u16(0xFFFF) + u16(31) + bytes(8),
+        "config-nan": u16(0x001) + bytes(12) + u16(0) + bytes([0, 0, 0, 0]) + struct.pack("<f", float("nan")) + bytes([6]),
+    }
+    for name, data in seeds.items():
+        (api / f"seed-{name}").write_bytes(data)
+
+    pgm = ROOT / "pgm"
+    pgm.mkdir(parents=True, exist_ok=True)
+    pix = bytes(rng.randrange(256) for _ in range(64 * 64))
+    pgm_seeds = {
+        "64x64": b"P5\n64 64\n255\n" + pix,
+        "comments": b"P5\n# a comment\n4 2 # another\n255\n" + pix[:8],
+        "tabs-crlf": b"P5\t3\r\n3\r\n255\r" + pix[:9],
+        "truncated": b"P5\n64 64\n255\n" + pix[:100],
+        "maxval-16": b"P5\n2 2\n65535\n" + pix[:8],
+        "ascii": b"P2\n2 2\n255\n1 2 3 4\n",
+        "huge": b"P5\n4096 4096\n255\n",
+    }
+    for name, data in pgm_seeds.items():
+        (pgm / f"seed-{name}").write_bytes(data)
+
+
+if __name__ == "__main__":
+    main()

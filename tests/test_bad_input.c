@@ -1,0 +1,247 @@
+/* The bad-input table: every misuse and malformed input libhome and its tools must refuse, each
+ * with the exact status it must give. One row per case: name, expected value, the call. Rows run
+ * on a fresh fixture (a valid 64x64 config, context, images and extracted features), so each row
+ * shows a single thing wrong. Also the test runner of home-hardening-tests: `NAME...` runs a
+ * subset, `--list` prints the table. */
+#include "test.h"
+#include "test_bad_input.h"
+#include "home.h"
+#include "pgm.h"
+#include "synth.h"
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+int test_failures;
+
+#define W 64
+#define H 64
+
+/* fixture */
+static home_config cfg, bad;
+static home_context *ctx, *ctx_other;
+static home_result res;
+static home_features fa, fb;
+static uint8_t img_a[W * H], img_b[W * H], img_other[(W + 32) * H], hough[1 << 16];
+static union { unsigned char bytes[4u << 20]; double align; } arena, arena_other;
+static union { unsigned char bytes[256]; double align; } junk;
+static size_t needed;
+static float col, row;
+static int hw, hh;
+
+static void fixture(void)
+{
+    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    home_default_config(&cfg, W, H);
+    cfg.keypoints_per_sign = 200; /* below the capacity, so a count can exceed one but not the other */
+    bad = cfg;
+    ctx = ctx_other = NULL;
+    needed = 0;
+    if (home_init(&ctx, &cfg, arena.bytes, sizeof arena.bytes, NULL) != HOME_OK) ctx = NULL;
+    synth_render(SYNTH_STRUCTURED, 3, identity, 0.0, 1, img_a, W, H, W);
+    memcpy(img_b, img_a, sizeof img_a);
+    memset(&fa, 0, sizeof fa);
+    memset(&fb, 0, sizeof fb);
+    if (ctx) {
+        home_extract(ctx, img_a, W, &fa);
+        home_extract(ctx, img_b, W, &fb);
+    }
+    memset(junk.bytes, 0x5a, sizeof junk.bytes);
+}
+
+/* features of another context: a frame of another size, or another config of the same size */
+static int match_foreign(int width, int height, int theta_bins)
+{
+    home_config other;
+    other = cfg;
+    other.width = width;
+    other.height = height;
+    other.theta_bins = theta_bins;
+    if (home_init(&ctx_other, &other, arena_other.bytes, sizeof arena_other.bytes, NULL) != HOME_OK)
+        return 1;
+    memset(img_other, 77, sizeof img_other);
+    if (home_extract(ctx_other, img_other, width, &fb) != HOME_OK) return 1;
+    return home_match(ctx, &fa, &fb, &res);
+}
+
+/* home_init with a too-small arena must also report the exact size it needs */
+static int init_short(size_t bytes)
+{
+    int s = home_init(&ctx, &cfg, arena.bytes, bytes, &needed);
+    return (needed == home_arena_size(&cfg) && ctx == NULL) ? s : 1;
+}
+
+static int pgm(const char *text, size_t size)
+{
+    int w, h;
+    const uint8_t *pixels;
+    char err[128] = "";
+    int s = pgm_parse((const uint8_t *)text, size, HOME_MAX_SIDE, &w, &h, &pixels, err, sizeof err);
+    return (s != 0 && err[0] == '\0') ? 1 : s; /* a refusal must say why */
+}
+#define PGM(literal) pgm(literal, sizeof literal - 1)
+
+/* name, expected value, expression; the comment column of the README's table */
+#define BAD_INPUTS(X) \
+    /* configuration */ \
+    X(config_null, HOME_E_NULL, home_default_config(NULL, W, H)) \
+    X(config_zero_width, HOME_E_SIZE, home_default_config(&bad, 0, H)) \
+    X(config_negative_height, HOME_E_SIZE, home_default_config(&bad, W, -64)) \
+    X(config_below_min_side, HOME_E_SIZE, home_default_config(&bad, HOME_MIN_SIDE - 1, H)) \
+    X(config_above_max_side, HOME_E_SIZE, home_default_config(&bad, W, HOME_MAX_SIDE + 1)) \
+    X(config_int_max_sides, HOME_E_SIZE, home_default_config(&bad, INT_MAX, INT_MAX)) \
+    X(validate_null, HOME_E_NULL, home_validate_config(NULL)) \
+    X(validate_area_overflows_int, HOME_E_SIZE, (bad.width = bad.height = 65536, home_validate_config(&bad))) \
+    X(validate_odd_sizes_accepted, HOME_OK, (bad.width = 33, bad.height = 97, home_validate_config(&bad))) \
+    X(theta_bins_zero, HOME_E_CONFIG, (bad.theta_bins = 0, home_validate_config(&bad))) \
+    X(theta_bins_negative, HOME_E_CONFIG, (bad.theta_bins = -480, home_validate_config(&bad))) \
+    X(theta_bins_above_max, HOME_E_CONFIG, (bad.theta_bins = HOME_MAX_THETA_BINS + 1, home_validate_config(&bad))) \
+    X(wrap_band_negative, HOME_E_CONFIG, (bad.wrap_band = -1, home_validate_config(&bad))) \
+    X(wrap_band_above_quarter, HOME_E_CONFIG, (bad.wrap_band = bad.theta_bins / 4 + 1, home_validate_config(&bad))) \
+    X(r_step_zero, HOME_E_CONFIG, (bad.r_step = 0.0f, home_validate_config(&bad))) \
+    X(r_step_nan, HOME_E_CONFIG, (bad.r_step = (float)NAN, home_validate_config(&bad))) \
+    X(r_step_inf, HOME_E_CONFIG, (bad.r_step = (float)INFINITY, home_validate_config(&bad))) \
+    X(r_bins_odd, HOME_E_CONFIG, (bad.r_bins = 201, home_validate_config(&bad))) \
+    X(r_bins_short_of_diagonal, HOME_E_CONFIG, (bad.r_bins = 2, home_validate_config(&bad))) \
+    X(r_bins_negative, HOME_E_CONFIG, (bad.r_bins = -200, home_validate_config(&bad))) \
+    X(smooth_sigma_negative, HOME_E_CONFIG, (bad.smooth_sigma = -1.3f, home_validate_config(&bad))) \
+    X(smooth_sigma_inf, HOME_E_CONFIG, (bad.smooth_sigma = (float)INFINITY, home_validate_config(&bad))) \
+    X(keypoints_zero, HOME_E_CONFIG, (bad.keypoints_per_sign = 0, home_validate_config(&bad))) \
+    X(keypoints_above_max, HOME_E_CONFIG, (bad.keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN + 1, home_validate_config(&bad))) \
+    X(ratio_nan, HOME_E_CONFIG, (bad.ratio = (float)NAN, home_validate_config(&bad))) \
+    X(ratio_above_one, HOME_E_CONFIG, (bad.ratio = 1.5f, home_validate_config(&bad))) \
+    X(ratio_minus_inf, HOME_E_CONFIG, (bad.ratio = -(float)INFINITY, home_validate_config(&bad))) \
+    X(threshold_final_zero, HOME_E_CONFIG, (bad.threshold_final = 0.0f, home_validate_config(&bad))) \
+    X(threshold_final_nan, HOME_E_CONFIG, (bad.threshold_final = (float)NAN, home_validate_config(&bad))) \
+    X(threshold_start_below_final, HOME_E_CONFIG, (bad.threshold_start = 0.5f, home_validate_config(&bad))) \
+    X(threshold_too_many_halvings, HOME_E_CONFIG, (bad.threshold_start = bad.threshold_final * (float)(1 << HOME_MAX_THRESHOLD_LEVELS), home_validate_config(&bad))) \
+    X(min_inliers_three, HOME_E_CONFIG, (bad.min_inliers = 3, home_validate_config(&bad))) \
+    X(min_inliers_above_max, HOME_E_CONFIG, (bad.min_inliers = 2 * HOME_MAX_KEYPOINTS_PER_SIGN + 1, home_validate_config(&bad))) \
+    X(arena_size_null, 0, (int)home_arena_size(NULL)) \
+    X(arena_size_bad_config, 0, (bad.theta_bins = 0, (int)home_arena_size(&bad))) \
+    /* context initialisation */ \
+    X(init_null_out, HOME_E_NULL, home_init(NULL, &cfg, arena.bytes, sizeof arena.bytes, NULL)) \
+    X(init_null_config, HOME_E_NULL, home_init(&ctx, NULL, arena.bytes, sizeof arena.bytes, NULL)) \
+    X(init_null_arena, HOME_E_NULL, home_init(&ctx, &cfg, NULL, sizeof arena.bytes, NULL)) \
+    X(init_bad_config, HOME_E_CONFIG, (bad.ratio = (float)NAN, home_init(&ctx, &bad, arena.bytes, sizeof arena.bytes, NULL))) \
+    X(init_arena_empty, HOME_E_ARENA_SMALL, init_short(0)) \
+    X(init_arena_one_byte_short, HOME_E_ARENA_SMALL, init_short(home_arena_size(&cfg) - 1)) \
+    X(init_arena_misaligned_1, HOME_E_ARENA_ALIGN, home_init(&ctx, &cfg, arena.bytes + 1, sizeof arena.bytes - 1, NULL)) \
+    X(init_arena_misaligned_8, HOME_E_ARENA_ALIGN, home_init(&ctx, &cfg, arena.bytes + 8, sizeof arena.bytes - 8, NULL)) \
+    /* feature extraction */ \
+    X(extract_null_context, HOME_E_NULL, home_extract(NULL, img_a, W, &fa)) \
+    X(extract_null_image, HOME_E_NULL, home_extract(ctx, NULL, W, &fa)) \
+    X(extract_null_features, HOME_E_NULL, home_extract(ctx, img_a, W, NULL)) \
+    X(extract_stride_below_width, HOME_E_STRIDE, home_extract(ctx, img_a, W - 1, &fa)) \
+    X(extract_stride_zero, HOME_E_STRIDE, home_extract(ctx, img_a, 0, &fa)) \
+    X(extract_stride_negative, HOME_E_STRIDE, home_extract(ctx, img_a + (H - 1) * W, -W, &fa)) \
+    X(extract_uninitialised_context, HOME_E_STATE, home_extract((home_context *)(void *)junk.bytes, img_a, W, &fa)) \
+    X(extract_context_overwritten, HOME_E_STATE, (memset(arena.bytes, 0, 64), home_extract(ctx, img_a, W, &fa))) \
+    /* matching: stages out of order, corrupted or foreign features */ \
+    X(match_before_extract, HOME_E_STATE, (memset(&fb, 0, sizeof fb), home_match(ctx, &fa, &fb, &res))) \
+    X(match_null_features, HOME_E_NULL, home_match(ctx, NULL, &fb, &res)) \
+    X(match_null_result, HOME_E_NULL, home_match(ctx, &fa, &fb, NULL)) \
+    X(match_null_context, HOME_E_NULL, home_match(NULL, &fa, &fb, &res)) \
+    X(match_negative_count, HOME_E_STATE, (fb.n_pos = -3, home_match(ctx, &fa, &fb, &res))) \
+    X(match_count_above_capacity, HOME_E_STATE, (fb.n_neg = HOME_MAX_KEYPOINTS_PER_SIGN + 1, home_match(ctx, &fa, &fb, &res))) \
+    X(match_count_above_config, HOME_E_MISMATCH, (fb.n_pos = cfg.keypoints_per_sign + 1, home_match(ctx, &fa, &fb, &res))) \
+    X(match_corrupt_magic, HOME_E_STATE, (fb.magic ^= 1u, home_match(ctx, &fa, &fb, &res))) \
+    X(match_frames_of_different_sizes, HOME_E_MISMATCH, match_foreign(W + 32, H, cfg.theta_bins)) \
+    X(match_features_of_other_config, HOME_E_MISMATCH, match_foreign(W, H, cfg.theta_bins / 2)) \
+    /* two-image registration */ \
+    X(register_null_context, HOME_E_NULL, home_register(NULL, img_a, W, img_b, W, &res)) \
+    X(register_null_image_b, HOME_E_NULL, home_register(ctx, img_a, W, NULL, W, &res)) \
+    X(register_stride_b_below_width, HOME_E_STRIDE, home_register(ctx, img_a, W, img_b, W / 2, &res)) \
+    X(register_null_result, HOME_E_NULL, home_register(ctx, img_a, W, img_b, W, NULL)) \
+    X(last_features_before_register, 0, home_last_features(ctx, 0) != NULL) \
+    X(last_features_index_out_of_range, 0, (home_register(ctx, img_a, W, img_b, W, &res), home_last_features(ctx, 2) != NULL)) \
+    /* inspection */ \
+    X(hough_size_null_output, HOME_E_NULL, home_hough_size(ctx, &hw, NULL)) \
+    X(render_hough_null_output, HOME_E_NULL, home_render_hough(ctx, img_a, W, NULL, 1024)) \
+    X(render_hough_stride_too_small, HOME_E_STRIDE, (home_hough_size(ctx, &hw, &hh), home_render_hough(ctx, img_a, W, hough, hw - 1))) \
+    X(keypoint_to_hough_null_keypoint, HOME_E_NULL, home_keypoint_to_hough(ctx, NULL, &col, &row)) \
+    X(strerror_unknown_code, 0, strcmp(home_strerror(-12345), "unknown status code")) \
+    /* PGM reader (examples/pgm.c): refusals return -1 with a reason */ \
+    X(pgm_empty, -1, PGM("")) \
+    X(pgm_garbage, -1, PGM("\x89PNG\r\n\x1a\n")) \
+    X(pgm_ascii_p2, -1, PGM("P2\n2 2\n255\n1 2 3 4\n")) \
+    X(pgm_16_bit, -1, PGM("P5\n2 2\n65535\n\1\2\3\4\5\6\7\10")) \
+    X(pgm_maxval_zero, -1, PGM("P5\n2 2\n0\n\1\2\3\4")) \
+    X(pgm_width_zero, -1, PGM("P5\n0 2\n255\n")) \
+    X(pgm_negative_height, -1, PGM("P5\n2 -2\n255\n\1\2\3\4")) \
+    X(pgm_side_above_limit, -1, PGM("P5\n4097 1\n255\n")) \
+    X(pgm_number_overflow, -1, PGM("P5\n99999999999999999999 2\n255\n")) \
+    X(pgm_no_separator_after_maxval, -1, PGM("P5\n2 2\n255")) \
+    X(pgm_truncated_raster, -1, PGM("P5\n2 2\n255\n\1\2\3")) \
+    X(pgm_with_comments_accepted, 0, PGM("P5 # c\n#only comment\n2 2 255\n\1\2\3\4")) \
+    X(pgm_trailing_bytes_accepted, 0, PGM("P5\n2 1\n255\n\1\2\3"))
+
+#define DEFINE_ROW(name, expect, expr) static int row_##name(void) { return (expr); }
+BAD_INPUTS(DEFINE_ROW)
+#define ROW_ENTRY(name, expect, expr) {#name, expect, row_##name},
+static const struct { const char *name; int expect; int (*run)(void); } table[] = {BAD_INPUTS(ROW_ENTRY)};
+
+#define ROW_COUNT (int)(sizeof table / sizeof table[0])
+
+static void test_bad_input_table(void)
+{
+    int i, failed = 0;
+    for (i = 0; i < ROW_COUNT; i++) {
+        int got;
+        fixture();
+        if (!ctx) { CHECK(ctx != NULL); return; }
+        got = table[i].run();
+        if (got != table[i].expect) {
+            failed++;
+            test_failures++;
+            fprintf(stderr, "    bad input %s: got %d (%s), expected %d (%s)\n", table[i].name, got,
+                    home_strerror(got), table[i].expect, home_strerror(table[i].expect));
+        }
+    }
+    printf("     %d bad-input rows, %d wrong\n", ROW_COUNT, failed);
+    CHECK(ROW_COUNT >= 30);
+}
+
+/* After every refusal the context still works: a refused call changes no state. */
+static void test_refusals_leave_context_usable(void)
+{
+    home_features again;
+    fixture();
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_extract(ctx, img_a, W - 1, &fb), HOME_E_STRIDE);
+    CHECK_EQ_INT(home_match(ctx, &fa, NULL, &res), HOME_E_NULL);
+    CHECK_EQ_INT(home_register(ctx, img_a, W, NULL, W, &res), HOME_E_NULL);
+    CHECK_EQ_INT(home_extract(ctx, img_a, W, &again), HOME_OK);
+    CHECK_EQ_INT(again.n_pos, fa.n_pos);
+    CHECK(memcmp(again.kp, fa.kp, (size_t)(fa.n_pos + fa.n_neg) * sizeof fa.kp[0]) == 0);
+}
+
+#define HARD_TEST_LIST(X) \
+    X(bad_input_table) X(refusals_leave_context_usable) HARD_TESTS_MORE(X)
+
+#define HARD_DECLARE(name) void test_##name(void);
+HARD_TESTS_MORE(HARD_DECLARE)
+#define HARD_ENTRY(name) {#name, test_##name},
+static const struct { const char *name; void (*fn)(void); } tests[] = {HARD_TEST_LIST(HARD_ENTRY)};
+
+int main(int argc, char **argv)
+{
+    int passed = 0, failed = 0, k;
+    size_t i;
+    if (argc == 2 && !strcmp(argv[1], "--list")) {
+        for (k = 0; k < ROW_COUNT; k++) printf("%-36s %d\n", table[k].name, table[k].expect);
+        return 0;
+    }
+    for (i = 0; i < sizeof tests / sizeof tests[0]; i++) {
+        int before = test_failures, selected = argc < 2;
+        for (k = 1; k < argc; k++) selected |= !strcmp(argv[k], tests[i].name);
+        if (!selected) continue;
+        tests[i].fn();
+        if (test_failures == before) { passed++; printf("ok   %s\n", tests[i].name); }
+        else { failed++; printf("FAIL %s\n", tests[i].name); }
+        fflush(stdout);
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
