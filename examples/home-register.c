@@ -36,6 +36,10 @@ static void usage(FILE *f)
         "  --threshold T        final inlier threshold in Hough pixels (default 1.0)\n"
         "  --threshold-start T  first inlier threshold, halved down to the final (default 64)\n"
         "  --min-inliers N      fewer final inliers means failure (default 20)\n"
+        "  --no-refine          keep HOME's homography (no photometric refinement)\n"
+        "  --refine-levels N    refinement pyramid levels (default 3)\n"
+        "  --refine-iterations N  Gauss-Newton iteration cap per level (default 10)\n"
+        "  --refine-trust PX    largest corner motion the refinement may make (default 4)\n"
         "  --repeat N           register N times; ms are medians, plus \"frame\": B against A's\n"
         "                       cached features (the video case)\n"
         "  --save-hough F.pgm   write A's quantised Hough image (rows theta, columns r) with\n"
@@ -123,7 +127,8 @@ int main(int argc, char **argv)
     const char *paths[2] = {NULL, NULL}, *hough_path = NULL;
     home_config cfg;
     int n_paths = 0, i, repeat = 1, status, s;
-    int opt_kp = -1, opt_theta = -1, opt_min_in = -1;
+    int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1;
+    float opt_rtrust = -1;
     float opt_ratio = -1, opt_thr = -1, opt_thr0 = -1, opt_rstep = -1, opt_sigma = -1;
     uint8_t *buf_a = NULL, *buf_b = NULL;
     const uint8_t *pa, *pb;
@@ -134,17 +139,21 @@ int main(int argc, char **argv)
     home_result res;
     double *samples, ms[HOME_STAGE_COUNT], frame_ms = 0.0;
     static const char *stage_names[HOME_STAGE_COUNT] = {"hough", "detect", "describe", "match",
-                                                        "homography", "total"};
+                                                        "homography", "refine", "total"};
 
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         int bad = 0;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
+        if (!strcmp(a, "--no-refine")) { opt_rlevels = 0; continue; }
         if (!strncmp(a, "--", 2) && !v) { fprintf(stderr, "home-register: %s needs a value\n", a); return 2; }
         if (!strcmp(a, "--keypoints")) bad = parse_int(v, &opt_kp), i++;
         else if (!strcmp(a, "--theta-bins")) bad = parse_int(v, &opt_theta), i++;
         else if (!strcmp(a, "--min-inliers")) bad = parse_int(v, &opt_min_in), i++;
+        else if (!strcmp(a, "--refine-levels")) bad = parse_int(v, &opt_rlevels), i++;
+        else if (!strcmp(a, "--refine-iterations")) bad = parse_int(v, &opt_riters), i++;
+        else if (!strcmp(a, "--refine-trust")) bad = parse_float(v, &opt_rtrust), i++;
         else if (!strcmp(a, "--repeat")) bad = parse_int(v, &repeat) || repeat < 1 || repeat > 10000, i++;
         else if (!strcmp(a, "--ratio")) bad = parse_float(v, &opt_ratio), i++;
         else if (!strcmp(a, "--threshold")) bad = parse_float(v, &opt_thr), i++;
@@ -180,6 +189,9 @@ int main(int argc, char **argv)
     if (opt_thr0 >= 0) cfg.threshold_start = opt_thr0;
     if (opt_rstep >= 0) cfg.r_step = opt_rstep;
     if (opt_sigma >= 0) cfg.smooth_sigma = opt_sigma;
+    if (opt_rlevels >= 0) cfg.refine_levels = opt_rlevels;
+    if (opt_riters >= 0) cfg.refine_iterations = opt_riters;
+    if (opt_rtrust >= 0) cfg.refine_trust_px = opt_rtrust;
     if (cfg.wrap_band > cfg.theta_bins / 4) cfg.wrap_band = cfg.theta_bins / 18;
     cfg.clock = clock_ms;
     if ((status = home_validate_config(&cfg)) != HOME_OK) {
@@ -231,8 +243,9 @@ int main(int argc, char **argv)
         for (i = 0; i < 9; i++) printf("%s%.10g", i ? "," : "", res.H[i]);
         printf("]");
     }
-    printf(",\"keypoints\":[%d,%d],\"matches\":%d,\"inliers\":%d,\"ms\":{", res.keypoints_a,
-           res.keypoints_b, res.matches, res.inliers);
+    printf(",\"keypoints\":[%d,%d],\"matches\":%d,\"inliers\":%d,\"refined\":%s,\"ms\":{",
+           res.keypoints_a, res.keypoints_b, res.matches, res.inliers,
+           res.refined ? "true" : "false");
     for (s = 0; s < HOME_STAGE_COUNT; s++) printf("%s\"%s\":%.3f", s ? "," : "", stage_names[s], ms[s]);
     if (repeat > 1) printf(",\"frame\":%.3f", frame_ms);
     printf("}}\n");

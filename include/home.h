@@ -79,6 +79,10 @@ typedef struct home_config {
     float threshold_start;    /* first inlier threshold, Hough pixels; halved down to ... */
     float threshold_final;    /* ... this final threshold; paper: 1.0 */
     int min_inliers;          /* fewer final inliers -> failure; paper: 20 */
+    /* photometric refinement of HOME's H (home_refine() below); refine_levels = 0 turns it off */
+    int refine_levels;        /* pyramid levels, 1..HOME_REFINE_MAX_LEVELS; default 3 */
+    int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
+    float refine_trust_px;    /* largest corner motion from HOME's H accepted, px; default 4 */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
     home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */
@@ -125,6 +129,8 @@ typedef struct home_features {
     int n_pos, n_neg;
     float j_std;              /* standard deviation of J (quantisation scale) */
     double ms_hough, ms_detect, ms_describe; /* extraction timings when a clock is set */
+    uint32_t frame_id;        /* refinement snapshot of this frame in the context (0: none) */
+    double ms_refine;         /* time spent on that snapshot */
     home_keypoint kp[2 * HOME_MAX_KEYPOINTS_PER_SIGN];
 } home_features;
 
@@ -133,7 +139,7 @@ int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home
 
 enum home_stage {
     HOME_STAGE_HOUGH, HOME_STAGE_DETECT, HOME_STAGE_DESCRIBE, HOME_STAGE_MATCH,
-    HOME_STAGE_HOMOGRAPHY, HOME_STAGE_TOTAL, HOME_STAGE_COUNT
+    HOME_STAGE_HOMOGRAPHY, HOME_STAGE_REFINE, HOME_STAGE_TOTAL, HOME_STAGE_COUNT
 };
 
 /* Why a registration did not succeed (result.ok == 0). */
@@ -144,21 +150,61 @@ enum home_failure {
     HOME_FAIL_DEGENERATE      /* det(H / H22) <= 0, or the estimate is numerically unusable */
 };
 
+/* What the photometric refinement did (result.refine_status). */
+enum home_refine_status {
+    HOME_REFINE_OFF = 0,          /* refine_levels == 0 */
+    HOME_REFINE_ACCEPTED,         /* H is the refined estimate (result.refined == 1) */
+    HOME_REFINE_NO_ESTIMATE,      /* HOME found no homography to start from */
+    HOME_REFINE_NO_SNAPSHOT,      /* a is not in the context's last two extracted frames, or b
+                                     is not the last one (see home_match) */
+    HOME_REFINE_FEW_POINTS,       /* too little texture: fewer than 64 usable template points */
+    HOME_REFINE_NOT_CONVERGED,    /* the finest level hit refine_iterations */
+    HOME_REFINE_ILL_CONDITIONED,  /* predicted corner standard deviation above 0.5 px */
+    HOME_REFINE_OUTSIDE_TRUST,    /* a corner moved more than refine_trust_px from HOME's H */
+    HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
+    HOME_REFINE_LOW_CORRELATION   /* HOME failed and the refinement cannot vouch (rule below) */
+};
+
 typedef struct home_result {
     int ok;                   /* 1: H is trustworthy by the failure rule */
     int failure;              /* enum home_failure */
     double H[9];              /* A -> B, row-major, H[8] = 1 (identity when not ok) */
     int keypoints_a, keypoints_b, matches, inliers;
+    int refined;              /* 1: H is HOME's estimate refined photometrically */
+    int refine_status;        /* enum home_refine_status */
+    int refine_iterations;    /* Gauss-Newton iterations over all levels */
+    double refine_error[2];   /* robust photometric error (mean Cauchy cost, grey levels^2) of
+                                 HOME's H and of the refined H over the points both keep */
+    double refine_zncc;       /* weighted correlation of A and gain/bias-corrected B there */
     double ms[HOME_STAGE_COUNT]; /* per-stage milliseconds (0 without a clock) */
 } home_result;
 
-/* Register features a (earlier frame) to b (current frame): H maps a's pixels to b's. */
+/* Register features a (earlier frame) to b (current frame): H maps a's pixels to b's.
+ *
+ * Refinement in video: home_extract() also keeps a snapshot of its frame in the context: the
+ * template points of its pyramid in one of two slots (the older is replaced) and the full pyramid
+ * of the newest frame only. home_match(a, b) refines when a is one of the last two frames
+ * extracted and b the last one (the usual previous/current order); otherwise it reports
+ * HOME_REFINE_NO_SNAPSHOT and keeps HOME's H. Extract + match gives the same H as
+ * home_register() on the same images.
+ *
+ * Failure rule with refinement: ok as HOME's rule says; in addition, a pair HOME rejects only
+ * for too few inliers (HOME_FAIL_FEW_INLIERS, at least 8 inliers) becomes ok when the
+ * refinement is accepted and refine_zncc >= 0.9: the photometric fit vouches for the estimate.
+ * When HOME failed, H stays HOME's unless that rescue applies. */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 
 /* Convenience: extract both images into the context's own feature slots and register a to b. */
 int home_register(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const uint8_t *b,
                   ptrdiff_t stride_b, home_result *result);
+
+/* Refine any estimate h_init (A -> B pixels, e.g. another method's) photometrically with the
+ * context's refinement settings. result->H gets the refined H when accepted, else h_init
+ * normalised; result->ok = result->refined; refine_* fields and ms[HOME_STAGE_REFINE] are set,
+ * the feature fields are 0. Replaces the context's frame snapshots. */
+int home_refine(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const uint8_t *b,
+                ptrdiff_t stride_b, const double *h_init, home_result *result);
 
 /* The features home_register() last extracted (0: image a, 1: image b), or NULL. */
 const home_features *home_last_features(const home_context *ctx, int which);

@@ -36,4 +36,16 @@
 #define HOME_MAX_THRESHOLD_LEVELS 12
 #endif
 
+/* Photometric refinement (src/refine.c): pyramid levels, template points kept at the finest level
+ * (halved per coarser level), and the largest Gauss-Newton iteration cap per level. */
+#ifndef HOME_REFINE_MAX_LEVELS
+#define HOME_REFINE_MAX_LEVELS 3
+#endif
+#ifndef HOME_REFINE_MAX_POINTS
+#define HOME_REFINE_MAX_POINTS 4096
+#endif
+#ifndef HOME_REFINE_MAX_ITERS
+#define HOME_REFINE_MAX_ITERS 50
+#endif
+
 #endif

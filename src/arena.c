@@ -37,6 +37,7 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->threshold_start = 64.0f;
     cfg->threshold_final = 1.0f;
     cfg->min_inliers = 20;
+    home__refine_defaults(cfg);
     cfg->simd = HOME_SIMD_AUTO;
     cfg->hough_method = HOME_HOUGH_FAST;
 #ifndef HOME_NO_GETENV
@@ -98,6 +99,7 @@ int home_validate_config(const home_config *cfg)
         return HOME_E_CONFIG;
     if (cfg->min_inliers < 4 || cfg->min_inliers > 2 * HOME_MAX_KEYPOINTS_PER_SIGN)
         return HOME_E_CONFIG;
+    if (home__refine_validate(cfg) != HOME_OK) return HOME_E_CONFIG;
     if (!home__kernels_for(cfg->simd)) return HOME_E_CONFIG; /* unknown or not compiled in */
     if (cfg->hough_method != HOME_HOUGH_FAST && cfg->hough_method != HOME_HOUGH_EXACT)
         return HOME_E_CONFIG;
@@ -129,7 +131,7 @@ typedef struct layout {
     size_t img_n, img_t, shift, row_lo, row_hi, first_row, line_sum, edge_prefix, line_j;
     ptrdiff_t img_n_stride, img_t_stride;
     size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, matches,
-        inliers, slots, total;
+        inliers, slots, refine, total;
     int max_matches;
 } layout;
 
@@ -179,6 +181,7 @@ static void plan(const home_config *cfg, layout *l)
     l->matches = take(&cur, (size_t)l->max_matches * sizeof(home__match));
     l->inliers = take(&cur, (size_t)l->max_matches * sizeof(int));
     l->slots = take(&cur, 2 * sizeof(home_features));
+    l->refine = take(&cur, home__refine_bytes(cfg));
     l->total = (cur + BLOCK_ALIGN - 1) & ~(size_t)(BLOCK_ALIGN - 1);
 }
 
@@ -244,6 +247,7 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
     ctx->slots = (home_features *)(void *)(base + l.slots);
     ctx->slots[0].magic = ctx->slots[1].magic = 0;
     ctx->slots_valid = 0;
+    home__refine_init(ctx, base + l.refine);
     ctx->magic = HOME__MAGIC_CTX;
     *out = ctx;
     return HOME_OK;

@@ -35,6 +35,26 @@ typedef struct home__match {
     float theta_a, r_a, theta_b, r_b;
 } home__match;
 
+/* refine.c: template points of one pyramid level, structure of arrays padded to 4 lanes */
+typedef struct home__refine_points {
+    int16_t *x, *y;                   /* level pixel */
+    int16_t *t;                       /* grey value */
+    int16_t *gx, *gy;                 /* 2x central differences */
+    int n, capacity;
+} home__refine_points;
+
+/* refine.c: per-frame snapshots (arena-backed): template points of the last two frames, the
+ * pyramid of the last one */
+typedef struct home__refine_state {
+    int levels;                       /* 0: refinement off */
+    int w[HOME_REFINE_MAX_LEVELS], h[HOME_REFINE_MAX_LEVELS];
+    uint8_t *pyr[HOME_REFINE_MAX_LEVELS];
+    uint32_t pyr_id, slot_id[2];
+    int next_slot;
+    home__refine_points tpl[2][HOME_REFINE_MAX_LEVELS];
+    void *scratch;
+} home__refine_state;
+
 struct home_context {
     uint32_t magic;
     home_config cfg;
@@ -64,6 +84,7 @@ struct home_context {
     int *inlier_index;                /* max_matches: indices of current inliers */
     home_features *slots;             /* 2: home_register()'s own features */
     int slots_valid;
+    home__refine_state refine;
 };
 
 /* arena.c */
@@ -121,5 +142,22 @@ typedef void (*home__residual_fn)(const void *user, int i, const double *p, doub
 int home__lm_solve(double *p, int n, const int *index, home__residual_fn fn, const void *user,
                    int max_iters);
 int home__solve_spd8(double *a, double *b);
+
+/* refine.c */
+void home__refine_defaults(home_config *cfg);
+int home__refine_validate(const home_config *cfg);
+size_t home__refine_bytes(const home_config *cfg);
+void home__refine_init(home_context *ctx, unsigned char *block);
+uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride);
+void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result);
+void home__refine_blur3(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                        ptrdiff_t dst_stride, int w, int h);
+void home__refine_downsample(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                             ptrdiff_t dst_stride, int dst_w, int dst_h);
+void home__refine_warp(const float *m, const int16_t *xs, const int16_t *ys, int n,
+                       const uint8_t *img, ptrdiff_t stride, int w, int h, float *out);
+void home__refine_accumulate(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
+                             const int16_t *gys, const float *r, const float *w, int n,
+                             const float *aff, float *acc);
 
 #endif

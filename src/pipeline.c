@@ -133,6 +133,9 @@ int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home
     fill_keypoints(ctx, &st.neg, -1, scale, out->kp + out->n_pos);
     out->ms_detect = st.ms_detect;
     out->ms_describe = st.ms_describe + (home__now(ctx) - t_end);
+    t_end = home__now(ctx);
+    out->frame_id = home__refine_store(ctx, image, stride);
+    out->ms_refine = home__now(ctx) - t_end;
     out->width = ctx->cfg.width;
     out->height = ctx->cfg.height;
     out->config_id = ctx->config_id;
@@ -183,6 +186,7 @@ static void add_extract_ms(home_result *r, const home_features *f)
     r->ms[HOME_STAGE_HOUGH] += f->ms_hough;
     r->ms[HOME_STAGE_DETECT] += f->ms_detect;
     r->ms[HOME_STAGE_DESCRIBE] += f->ms_describe;
+    r->ms[HOME_STAGE_REFINE] += f->ms_refine;
 }
 
 static void sum_total(home_result *r)
@@ -202,6 +206,7 @@ int home_match(home_context *ctx, const home_features *a, const home_features *b
     if ((status = check_features(ctx, a)) != HOME_OK) return status;
     if ((status = check_features(ctx, b)) != HOME_OK) return status;
     match_and_estimate(ctx, a, b, result);
+    home__refine_apply(ctx, a->frame_id, b->frame_id, result);
     add_extract_ms(result, b); /* the video case: only the new frame was extracted */
     sum_total(result);
     return HOME_OK;
@@ -221,6 +226,7 @@ int home_register(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const
     if ((status = home_extract(ctx, b, stride_b, &ctx->slots[1])) != HOME_OK) return status;
     ctx->slots_valid = 1;
     match_and_estimate(ctx, &ctx->slots[0], &ctx->slots[1], result);
+    home__refine_apply(ctx, ctx->slots[0].frame_id, ctx->slots[1].frame_id, result);
     add_extract_ms(result, &ctx->slots[0]);
     add_extract_ms(result, &ctx->slots[1]);
     sum_total(result);

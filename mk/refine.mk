@@ -1,0 +1,20 @@
+# Photometric refinement (issue 8): its test binary (run by `make test`) and the bench tool that
+# refines any estimate (bench/refine/refine_eval.py uses it for ORB + refinement).
+REFINE_TESTS := $(BUILD)/bin/home-refine-tests
+REFINE_PAIR := $(BUILD)/bin/home-refine-pair
+BINS += $(REFINE_TESTS) $(REFINE_PAIR)
+TEST_BINS += $(REFINE_TESTS)
+# `all` expands BINS before this file is read: name the targets explicitly
+all: $(REFINE_TESTS) $(REFINE_PAIR)
+
+$(REFINE_TESTS): $(BUILD)/obj/tests/test_refine.o $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+
+$(BUILD)/obj/bench/refine/%.o: bench/refine/%.c include/home.h $(wildcard examples/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) -c $< -o $@
+
+$(REFINE_PAIR): $(BUILD)/obj/bench/refine/refine-pair.o $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)

@@ -1,0 +1,783 @@
+/* Sub-pixel photometric refinement of HOME's homography (issue 8).
+ *
+ * Method: inverse-compositional Lucas-Kanade (Baker & Matthews) of the 8 homography parameters on
+ * a 2x2-box pyramid, coarse to fine, started from HOME's estimate. The template is frame A: its
+ * points and gradients are chosen once per frame when it is extracted, so in video a frame costs
+ * one pyramid, one point selection and a few warps of the new frame. Photometric invariance: a
+ * gain and bias (alpha * B + beta ~ A) re-fitted by weighted least squares every iteration.
+ * Robustness: IRLS with Cauchy weights at 2.385 sigma, sigma = 1.4826 * median |residual|, so
+ * occluders and moving objects lose their pull. Every level has a fixed iteration cap.
+ *
+ * Template points: per level, the pixel of largest |gx| + |gy| in each block (4x4 at full
+ * resolution, 2x2 at half, 1x1 below) whose gradient clears a noise floor, strongest first up
+ * to HOME_REFINE_MAX_POINTS >> level. Flat regions contribute nothing to LK but cost time.
+ *
+ * Safeguards (result.refine_status): the refined H replaces HOME's only if the finest level
+ * converged within its cap, the robust photometric error over the points both warps keep
+ * is lower, the corners moved at most refine_trust_px, and the estimate is well conditioned
+ * (predicted corner standard deviation). Otherwise HOME's H stays.
+ *
+ * Coordinates: normalised u = (x - cx) / f, v = (y - cy) / f with cx, cy the image centre and
+ * f half the longer side, so the 8 parameters are O(1) at every level. Level l pixel x_l sits at
+ * full-resolution x = 2^l x_l + (2^l - 1) / 2. */
+#include "home_internal.h"
+#include <math.h>
+#include <string.h>
+
+#define LANES 4
+#define N_ACC 44            /* 36 upper-triangle entries of J^T W J, then 8 of J^T W r */
+#define HIST_BINS 512       /* |residual| histogram, 1/8 grey level per bin */
+#define CAUCHY_K 2.385     /* 95 % efficiency at Gaussian noise */
+#define SIGMA_FLOOR 0.5     /* grey levels: the residual scale never collapses below this */
+#define MIN_POINTS 64       /* fewer usable template points at a level: textureless, decline */
+#define STEP_EPS_PX 0.01    /* convergence: largest corner update, full-resolution px */
+#define MAX_CORNER_STD_PX 0.5 /* predicted corner standard deviation above this: ill conditioned */
+
+/* Noise floor of the selection score |gx| + |gy| (2x central differences, grey levels) at each
+ * level: above camera noise of sigma ~3 at full resolution, halved per level as 2x2 averaging
+ * halves the noise. */
+static int score_floor(int level)
+{
+    static const int floor_at[HOME_REFINE_MAX_LEVELS > 3 ? HOME_REFINE_MAX_LEVELS : 3] = {24, 12, 8};
+    return level < 3 ? floor_at[level] : 6;
+}
+
+static int block_side(int level) { return level >= 2 ? 1 : 4 >> level; }
+
+static int level_capacity(int level)
+{
+    int c = HOME_REFINE_MAX_POINTS >> level;
+    c = c < 64 ? 64 : c;
+    return (c + LANES - 1) & ~(LANES - 1);
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Configuration and arena layout */
+
+void home__refine_defaults(home_config *cfg)
+{
+    cfg->refine_levels = HOME_REFINE_MAX_LEVELS < 3 ? HOME_REFINE_MAX_LEVELS : 3;
+    cfg->refine_iterations = 10;
+    cfg->refine_trust_px = 4.0f;
+}
+
+int home__refine_validate(const home_config *cfg)
+{
+    if (cfg->refine_levels == 0) return HOME_OK; /* off: the other fields are ignored */
+    if (cfg->refine_levels < 0 || cfg->refine_levels > HOME_REFINE_MAX_LEVELS) return HOME_E_CONFIG;
+    if (cfg->refine_iterations < 1 || cfg->refine_iterations > HOME_REFINE_MAX_ITERS)
+        return HOME_E_CONFIG;
+    if (!(isfinite(cfg->refine_trust_px) && cfg->refine_trust_px >= 0.05f &&
+          cfg->refine_trust_px <= 256.0f))
+        return HOME_E_CONFIG;
+    return HOME_OK;
+}
+
+/* Levels actually used: the coarsest must keep at least 16 px a side. */
+static int levels_for(const home_config *cfg)
+{
+    int l = cfg->refine_levels;
+    while (l > 1 && ((cfg->width >> (l - 1)) < 16 || (cfg->height >> (l - 1)) < 16)) l--;
+    return l;
+}
+
+static size_t align64(size_t n) { return (n + 63u) & ~(size_t)63u; }
+
+static size_t blocks_at(const home_config *cfg, int level)
+{
+    size_t b = (size_t)block_side(level);
+    size_t w = (size_t)(cfg->width >> level), h = (size_t)(cfg->height >> level);
+    return ((w + b - 1) / b) * ((h + b - 1) / b);
+}
+
+/* Scratch: per-point floats at match time (two warps, residuals, weights), or the block
+ * scores of the point selection at extraction time. */
+static size_t scratch_bytes(const home_config *cfg)
+{
+    size_t match = 4 * (size_t)level_capacity(0) * sizeof(float), sel = 0;
+    int l;
+    for (l = 0; l < levels_for(cfg); l++) {
+        size_t s = blocks_at(cfg, l) * sizeof(uint16_t);
+        if (s > sel) sel = s;
+    }
+    return match > sel ? match : sel;
+}
+
+size_t home__refine_bytes(const home_config *cfg)
+{
+    size_t total = 0;
+    int l, n = cfg->refine_levels ? levels_for(cfg) : 0;
+    for (l = 0; l < n; l++) {
+        total += align64((size_t)(cfg->width >> l) * (size_t)(cfg->height >> l));
+        total += 2 * 5 * align64((size_t)level_capacity(l) * sizeof(int16_t));
+    }
+    if (n) total += align64(scratch_bytes(cfg));
+    return total;
+}
+
+void home__refine_init(home_context *ctx, unsigned char *block)
+{
+    home__refine_state *st = &ctx->refine;
+    int l, s;
+    memset(st, 0, sizeof *st);
+    st->levels = ctx->cfg.refine_levels ? levels_for(&ctx->cfg) : 0;
+    for (l = 0; l < st->levels; l++) {
+        st->w[l] = ctx->cfg.width >> l;
+        st->h[l] = ctx->cfg.height >> l;
+        st->pyr[l] = block;
+        block += align64((size_t)st->w[l] * (size_t)st->h[l]);
+        for (s = 0; s < 2; s++) {
+            home__refine_points *p = &st->tpl[s][l];
+            size_t bytes = align64((size_t)level_capacity(l) * sizeof(int16_t));
+            p->capacity = level_capacity(l);
+            p->x = (int16_t *)(void *)block; block += bytes;
+            p->y = (int16_t *)(void *)block; block += bytes;
+            p->t = (int16_t *)(void *)block; block += bytes;
+            p->gx = (int16_t *)(void *)block; block += bytes;
+            p->gy = (int16_t *)(void *)block; block += bytes;
+        }
+    }
+    st->scratch = st->levels ? (void *)block : NULL;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Scalar reference kernels (SIMD backends reproduce them: integers exactly, floats lane by lane
+ * in the same operation order) */
+
+/* 3x3 binomial blur ([1 2 1] / 4 both ways, rounded once), edges replicated. Sharp, aliased
+ * edges would otherwise bias bilinear interpolation by hundredths of a pixel. */
+void home__refine_blur3(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                        ptrdiff_t dst_stride, int w, int h)
+{
+    int x, y;
+    for (y = 0; y < h; y++) {
+        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
+        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
+        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
+        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        for (x = 0; x < w; x++) {
+            int l = x > 0 ? x - 1 : 0, r = x < w - 1 ? x + 1 : w - 1;
+            int left = a[l] + 2 * b[l] + c[l], mid = a[x] + 2 * b[x] + c[x];
+            int right = a[r] + 2 * b[r] + c[r];
+            d[x] = (uint8_t)((left + 2 * mid + right + 8) >> 4);
+        }
+    }
+}
+
+/* 2x2 box average with rounding: dst is (src_w / 2) x (src_h / 2). */
+void home__refine_downsample(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                             ptrdiff_t dst_stride, int dst_w, int dst_h)
+{
+    int x, y;
+    for (y = 0; y < dst_h; y++) {
+        const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
+        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        for (x = 0; x < dst_w; x++)
+            d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
+    }
+}
+
+/* Bilinear samples of img at m * (x, y, 1) (perspective divide); -1 where the sample or its
+ * 2x2 support leaves the image or the point maps behind the camera. */
+void home__refine_warp(const float *m, const int16_t *xs, const int16_t *ys, int n,
+                       const uint8_t *img, ptrdiff_t stride, int w, int h, float *out)
+{
+    const float xmax = (float)(w - 1), ymax = (float)(h - 1);
+    int i;
+    for (i = 0; i < n; i++) {
+        float x = (float)xs[i], y = (float)ys[i];
+        float d = m[6] * x + m[7] * y + m[8];
+        float px = (m[0] * x + m[1] * y + m[2]) / d;
+        float py = (m[3] * x + m[4] * y + m[5]) / d;
+        if (d > 0.0f && px >= 0.0f && py >= 0.0f && px < xmax && py < ymax) {
+            int ix = (int)px, iy = (int)py;
+            float fx = px - (float)ix, fy = py - (float)iy;
+            const uint8_t *p = img + (ptrdiff_t)iy * stride + ix;
+            float top = (float)p[0] + fx * (float)(p[1] - p[0]);
+            float bot = (float)p[stride] + fx * (float)(p[stride + 1] - p[stride]);
+            out[i] = top + fy * (bot - top);
+        } else {
+            out[i] = -1.0f;
+        }
+    }
+}
+
+/* Weighted normal equations of one IC step, per lane (point i feeds lane i % 4):
+ * acc[k * 4 + lane], k < 36: upper triangle of sum w sd sd^T; k = 36 + j: sum w sd_j r, with
+ * sd = (gx u, gx v, gx, gy u, gy v, gy, -u (gx u + gy v), -v (gx u + gy v)),
+ * u = a x + bu, v = a y + bv. n is a multiple of 4. */
+void home__refine_accumulate(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
+                             const int16_t *gys, const float *r, const float *w, int n,
+                             const float *aff, float *acc)
+{
+    int i, p, q, k;
+    memset(acc, 0, N_ACC * LANES * sizeof *acc);
+    for (i = 0; i < n; i++) {
+        const int lane = i & (LANES - 1);
+        float u = aff[0] * (float)xs[i] + aff[1], v = aff[0] * (float)ys[i] + aff[2];
+        float gx = (float)gxs[i], gy = (float)gys[i];
+        float gr = gx * u + gy * v;
+        float sd[8], wr = w[i] * r[i];
+        sd[0] = gx * u; sd[1] = gx * v; sd[2] = gx;
+        sd[3] = gy * u; sd[4] = gy * v; sd[5] = gy;
+        sd[6] = -(u * gr); sd[7] = -(v * gr);
+        for (p = 0, k = 0; p < 8; p++) {
+            float ws = w[i] * sd[p];
+            for (q = p; q < 8; q++, k++) acc[k * LANES + lane] += ws * sd[q];
+            acc[(36 + p) * LANES + lane] += sd[p] * wr;
+        }
+    }
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Per-frame snapshot: pyramid and template points */
+
+static uint32_t hash_bytes(const uint8_t *p, size_t n)
+{
+    uint32_t h = 2166136261u;
+    size_t i;
+    for (i = 0; i + 4 <= n; i += 4) {
+        uint32_t v = (uint32_t)p[i] | (uint32_t)p[i + 1] << 8 | (uint32_t)p[i + 2] << 16 |
+                     (uint32_t)p[i + 3] << 24;
+        h = (h ^ v) * 16777619u;
+        h ^= h >> 15;
+    }
+    for (; i < n; i++) h = (h ^ p[i]) * 16777619u;
+    return h ? h : 1u;
+}
+
+/* Pick the strongest-gradient pixel of every block, keep those above the level's floor,
+ * strongest first (score bins, then scan order) up to the capacity. */
+static void select_points(const uint8_t *img, int w, int h, int level, uint16_t *cells,
+                          home__refine_points *out)
+{
+    const int b = block_side(level), floor_score = score_floor(level);
+    const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
+    int hist[256], bx, by, x, y, bin, quota, n = 0, cut, above;
+    memset(hist, 0, sizeof hist);
+    for (by = 0; by < bh; by++) {
+        for (bx = 0; bx < bw; bx++) {
+            int best = -1, best_off = 0;
+            for (y = by * b; y < by * b + b && y < h - 1; y++) {
+                const uint8_t *row = img + (ptrdiff_t)y * w;
+                if (y < 1) continue;
+                for (x = bx * b; x < bx * b + b && x < w - 1; x++) {
+                    int gx, gy, s;
+                    if (x < 1) continue;
+                    gx = row[x + 1] - row[x - 1];
+                    gy = row[x + w] - row[x - w];
+                    s = (gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy);
+                    if (s > best) best = s, best_off = (y - by * b) * b + (x - bx * b);
+                }
+            }
+            if (best >= floor_score) {
+                bin = best >> 2 > 255 ? 255 : best >> 2;
+                hist[bin]++;
+                cells[by * bw + bx] = (uint16_t)(bin << 4 | best_off) | 0x8000u;
+            } else {
+                cells[by * bw + bx] = 0;
+            }
+        }
+    }
+    /* lowest bin that still fits, and how many of that bin are allowed */
+    above = 0;
+    for (cut = 255; cut > 0; cut--) {
+        if (above + hist[cut] >= out->capacity) break;
+        above += hist[cut];
+    }
+    quota = out->capacity - above;
+    for (by = 0; by < bh; by++) {
+        for (bx = 0; bx < bw; bx++) {
+            unsigned c = cells[by * bw + bx];
+            const uint8_t *p;
+            if (!(c & 0x8000u)) continue;
+            bin = (int)((c >> 4) & 0xffu);
+            if (bin < cut || (bin == cut && quota <= 0)) continue;
+            if (bin == cut) quota--;
+            x = bx * b + (int)(c & 15u) % b;
+            y = by * b + (int)(c & 15u) / b;
+            p = img + (ptrdiff_t)y * w + x;
+            out->x[n] = (int16_t)x;
+            out->y[n] = (int16_t)y;
+            out->t[n] = (int16_t)p[0];
+            out->gx[n] = (int16_t)(p[1] - p[-1]);
+            out->gy[n] = (int16_t)(p[w] - p[-w]);
+            n++;
+        }
+    }
+    out->n = n;
+    /* pad to whole lanes with inert points (zero gradient, zero weight at match time) */
+    for (; n % LANES; n++) out->x[n] = out->y[n] = out->t[n] = out->gx[n] = out->gy[n] = 0;
+}
+
+uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
+{
+    home__refine_state *st = &ctx->refine;
+    int l, slot;
+    if (!st->levels) return 0;
+    home__refine_blur3(image, stride, st->pyr[0], st->w[0], st->w[0], st->h[0]);
+    for (l = 1; l < st->levels; l++)
+        home__refine_downsample(st->pyr[l - 1], st->w[l - 1], st->pyr[l], st->w[l], st->w[l], st->h[l]);
+    /* the id is a hash of the data: the same frame gets the same id, so outputs stay
+     * deterministic, and features are tied to the snapshot they were extracted with */
+    l = st->levels > 1 ? 1 : 0;
+    st->pyr_id = hash_bytes(st->pyr[l], (size_t)st->w[l] * (size_t)st->h[l]);
+    slot = st->next_slot;
+    st->next_slot ^= 1;
+    for (l = 0; l < st->levels; l++)
+        select_points(st->pyr[l], st->w[l], st->h[l], l, (uint16_t *)st->scratch, &st->tpl[slot][l]);
+    st->slot_id[slot] = st->pyr_id;
+    return st->pyr_id;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Gauss-Newton */
+
+typedef struct solver {
+    const home__refine_state *st;
+    const home__refine_points *tpl;     /* template (frame A) points, one per level */
+    double f, cx, cy;                   /* normalisation */
+    double hn[9];                       /* A -> B in normalised coordinates */
+    double alpha, beta;                 /* photometric model alpha * B + beta ~ A */
+    double sigma;                       /* residual scale of the last iteration */
+    double jtj[64];                     /* last weighted normal matrix (normalised units) */
+    double resid_var;                   /* weighted residual variance of the last iteration */
+    float *img_b, *img_b2, *res, *wt;   /* per-point scratch */
+} solver;
+
+static void mat3_mul(const double *a, const double *b, double *out)
+{
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            out[i * 3 + j] = a[i * 3 + 0] * b[0 * 3 + j] + a[i * 3 + 1] * b[1 * 3 + j] +
+                             a[i * 3 + 2] * b[2 * 3 + j];
+}
+
+static int mat3_inv(const double *m, double *out)
+{
+    double d = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+               m[2] * (m[3] * m[7] - m[4] * m[6]);
+    if (!(fabs(d) > 1e-300) || !isfinite(d)) return 0;
+    out[0] = (m[4] * m[8] - m[5] * m[7]) / d;
+    out[1] = (m[2] * m[7] - m[1] * m[8]) / d;
+    out[2] = (m[1] * m[5] - m[2] * m[4]) / d;
+    out[3] = (m[5] * m[6] - m[3] * m[8]) / d;
+    out[4] = (m[0] * m[8] - m[2] * m[6]) / d;
+    out[5] = (m[2] * m[3] - m[0] * m[5]) / d;
+    out[6] = (m[3] * m[7] - m[4] * m[6]) / d;
+    out[7] = (m[1] * m[6] - m[0] * m[7]) / d;
+    out[8] = (m[0] * m[4] - m[1] * m[3]) / d;
+    return 1;
+}
+
+static void normalise9(double *h)
+{
+    int k;
+    double s = h[8];
+    for (k = 0; k < 9; k++) h[k] /= s;
+}
+
+/* pixel H -> normalised N H N^-1, and back */
+static void to_normalised(const solver *s, const double *h, double *hn)
+{
+    const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
+    const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
+    double t[9];
+    mat3_mul(n, h, t);
+    mat3_mul(t, ni, hn);
+    normalise9(hn);
+}
+
+static void to_pixels(const solver *s, const double *hn, double *h)
+{
+    const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
+    const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
+    double t[9];
+    mat3_mul(ni, hn, t);
+    mat3_mul(t, n, h);
+    normalise9(h);
+}
+
+/* Matrix taking template level-l pixels to B's level-l pixels under hn. */
+static void level_matrix(const solver *s, const double *hn, int level, float *m)
+{
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const double q[9] = {sc / s->f, 0, (o - s->cx) / s->f, 0, sc / s->f, (o - s->cy) / s->f, 0, 0, 1};
+    const double p[9] = {s->f / sc, 0, (s->cx - o) / sc, 0, s->f / sc, (s->cy - o) / sc, 0, 0, 1};
+    double t[9], r[9];
+    int k;
+    mat3_mul(hn, q, t);
+    mat3_mul(p, t, r);
+    for (k = 0; k < 9; k++) m[k] = (float)r[k];
+}
+
+/* Robust scale: 1.4826 * median |r| over the valid points, from a histogram. */
+static double robust_sigma(const float *img_b, const int16_t *t, int n, double alpha, double beta)
+{
+    int hist[HIST_BINS + 1], i, count = 0, half, acc = 0;
+    memset(hist, 0, sizeof hist);
+    for (i = 0; i < n; i++) {
+        double r, a;
+        int bin;
+        if (img_b[i] < 0.0f) continue;
+        r = alpha * img_b[i] + beta - t[i];
+        a = fabs(r) * 8.0;
+        bin = a < HIST_BINS ? (int)a : HIST_BINS;
+        hist[bin]++;
+        count++;
+    }
+    if (!count) return SIGMA_FLOOR;
+    half = (count + 1) / 2;
+    for (i = 0; i <= HIST_BINS; i++) {
+        acc += hist[i];
+        if (acc >= half) break;
+    }
+    {
+        double med = (i + 0.5) / 8.0, sigma = 1.4826 * med;
+        return sigma > SIGMA_FLOOR ? sigma : SIGMA_FLOOR;
+    }
+}
+
+/* Cauchy weight and cost at scale c: the influence of a residual fades as 1/|r| far out, so
+ * occluders and moving objects barely pull, yet no point is ever cut off outright. */
+static double robust_weight(double r, double c)
+{
+    double q = r / c;
+    return 1.0 / (1.0 + q * q);
+}
+
+static double robust_cost(double r, double c)
+{
+    double q = r / c;
+    return 0.5 * c * c * log(1.0 + q * q);
+}
+
+/* Weighted least-squares gain and bias of alpha * B + beta ~ A with Cauchy weights at scale
+ * sigma from the residuals of the current (alpha, beta); writes weights and new residuals.
+ * mask (optional): only points valid there too. Returns the number of valid points. */
+static int fit_photometric(solver *s, const home__refine_points *tp, const float *img_b,
+                           const float *mask, double sigma, float *res, float *wt)
+{
+    const double c = CAUCHY_K * sigma;
+    double sw = 0, sb = 0, sa = 0, sbb = 0, sab = 0, den;
+    int i, n = 0;
+    for (i = 0; i < tp->n; i++) {
+        double r, w, b;
+        if (img_b[i] < 0.0f || (mask && mask[i] < 0.0f)) { wt[i] = 0.0f; continue; }
+        b = img_b[i];
+        r = s->alpha * b + s->beta - tp->t[i];
+        w = robust_weight(r, c);
+        wt[i] = (float)w;
+        sw += w; sb += w * b; sa += w * tp->t[i]; sbb += w * b * b; sab += w * b * tp->t[i];
+        n++;
+    }
+    if (n && sw > 0) {
+        den = sw * sbb - sb * sb;
+        if (den > 1e-6 * sw * sw) {
+            s->alpha = (sw * sab - sb * sa) / den;
+            s->beta = (sa - s->alpha * sb) / sw;
+        } else {
+            s->alpha = 1.0;
+            s->beta = (sa - sb) / sw;
+        }
+    }
+    for (i = 0; i < tp->n; i++)
+        res[i] = wt[i] > 0.0f ? (float)(s->alpha * img_b[i] + s->beta - tp->t[i]) : 0.0f;
+    for (; i < ((tp->n + LANES - 1) & ~(LANES - 1)); i++) res[i] = wt[i] = 0.0f;
+    return n;
+}
+
+/* Largest displacement of the image corners (full-resolution px) by the linearised update dp. */
+static double corner_step_px(const solver *s, const double *dp)
+{
+    const double hu = s->cx / s->f, hv = s->cy / s->f;
+    double worst = 0.0;
+    int k;
+    for (k = 0; k < 4; k++) {
+        double u = (k & 1) ? hu : -hu, v = (k & 2) ? hv : -hv;
+        double du = dp[0] * u + dp[1] * v + dp[2] - (dp[6] * u + dp[7] * v) * u;
+        double dv = dp[3] * u + dp[4] * v + dp[5] - (dp[6] * u + dp[7] * v) * v;
+        double d = sqrt(du * du + dv * dv) * s->f;
+        if (d > worst) worst = d;
+    }
+    return worst;
+}
+
+/* One IRLS Gauss-Newton step at a level. Returns 0 when too few points stay usable or the
+ * system is singular; *step_px gets the corner motion of the update. */
+static int iterate(solver *s, int level, double *step_px)
+{
+    const home__refine_state *st = s->st;
+    const home__refine_points *tp = &s->tpl[level];
+    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const double k = s->f / (2.0 * sc);  /* template gradient: 2x central difference per level px */
+    float m[9], aff[3], acc[N_ACC * LANES];
+    double a[64], g[8], dp[9], hd[9], hdi[9], t[9], sum_w = 0, sum_wr2 = 0;
+    int i, j, p, q, valid;
+
+    level_matrix(s, s->hn, level, m);
+    home__refine_warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
+                      st->h[level], s->img_b);
+    s->sigma = robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta);
+    valid = fit_photometric(s, tp, s->img_b, NULL, s->sigma, s->res, s->wt);
+    if (valid < MIN_POINTS) return 0;
+    aff[0] = (float)(sc / s->f);
+    aff[1] = (float)((o - s->cx) / s->f);
+    aff[2] = (float)((o - s->cy) / s->f);
+    home__refine_accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff, acc);
+    for (p = 0, j = 0; p < 8; p++) {
+        for (q = p; q < 8; q++, j++) {
+            const float *l = acc + j * LANES;
+            double v = ((double)l[0] + (double)l[1]) + ((double)l[2] + (double)l[3]);
+            a[p * 8 + q] = a[q * 8 + p] = v * k * k;
+        }
+        {
+            const float *l = acc + (36 + p) * LANES;
+            g[p] = (((double)l[0] + (double)l[1]) + ((double)l[2] + (double)l[3])) * k;
+        }
+    }
+    memcpy(s->jtj, a, sizeof a);
+    for (i = 0; i < tp->n; i++) {
+        sum_w += s->wt[i];
+        sum_wr2 += (double)s->wt[i] * s->res[i] * s->res[i];
+    }
+    s->resid_var = sum_w > 8 ? sum_wr2 / (sum_w - 8) : sum_wr2;
+    if (!home__solve_spd8(a, g)) return 0;
+    for (p = 0; p < 8; p++) dp[p] = g[p];
+    *step_px = corner_step_px(s, dp);
+    hd[0] = 1 + dp[0]; hd[1] = dp[1]; hd[2] = dp[2];
+    hd[3] = dp[3]; hd[4] = 1 + dp[4]; hd[5] = dp[5];
+    hd[6] = dp[6]; hd[7] = dp[7]; hd[8] = 1;
+    if (!mat3_inv(hd, hdi)) return 0;
+    mat3_mul(s->hn, hdi, t);
+    normalise9(t);
+    for (i = 0; i < 9; i++)
+        if (!isfinite(t[i])) return 0;
+    memcpy(s->hn, t, sizeof t);
+    return 1;
+}
+
+/* Predicted standard deviation of the worst corner, px: sqrt(J_c (sigma^2 A^-1) J_c^T). */
+static double corner_std_px(const solver *s)
+{
+    const double hu = s->cx / s->f, hv = s->cy / s->f;
+    double worst = 0.0;
+    int k, axis;
+    for (k = 0; k < 4; k++) {
+        double u = (k & 1) ? hu : -hu, v = (k & 2) ? hv : -hv, var = 0.0;
+        for (axis = 0; axis < 2; axis++) {
+            double jc[8], z[8], a[64], q = 0.0;
+            int i;
+            memset(jc, 0, sizeof jc);
+            if (axis == 0) { jc[0] = u; jc[1] = v; jc[2] = 1; jc[6] = -u * u; jc[7] = -u * v; }
+            else { jc[3] = u; jc[4] = v; jc[5] = 1; jc[6] = -u * v; jc[7] = -v * v; }
+            memcpy(a, s->jtj, sizeof a);
+            memcpy(z, jc, sizeof z);
+            if (!home__solve_spd8(a, z)) return INFINITY;
+            for (i = 0; i < 8; i++) q += jc[i] * z[i];
+            var += q;
+        }
+        var *= s->resid_var * s->f * s->f;
+        if (sqrt(var) > worst) worst = sqrt(var);
+    }
+    return worst;
+}
+
+/* Robust photometric error of hn at the finest level over the points valid under both hn and
+ * other_b (B samples under the other estimate): mean Cauchy cost at the fixed scale sigma, after
+ * re-fitting gain and bias. Also the weighted correlation of A and B there. */
+static double photometric_error(solver *s, const double *hn, const float *other_b, double sigma,
+                                float *img_b, double *zncc)
+{
+    const home__refine_state *st = s->st;
+    const home__refine_points *tp = &s->tpl[0];
+    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    const double c = CAUCHY_K * sigma;
+    double cost = 0, sw = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, va, vb;
+    float m[9];
+    int i, it, n = 0;
+    level_matrix(s, hn, 0, m);
+    home__refine_warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], img_b);
+    s->alpha = 1.0;
+    s->beta = 0.0;
+    for (it = 0; it < 3; it++) fit_photometric(s, tp, img_b, other_b, sigma, s->res, s->wt);
+    for (i = 0; i < tp->n; i++) {
+        double w = s->wt[i], a = tp->t[i], b = img_b[i];
+        if (img_b[i] < 0.0f || other_b[i] < 0.0f) continue;
+        cost += robust_cost(s->res[i], c);
+        n++;
+        sw += w; sa += w * a; sb += w * b; saa += w * a * a; sbb += w * b * b; sab += w * a * b;
+    }
+    *zncc = 0.0;
+    if (sw > 0) {
+        va = saa - sa * sa / sw;
+        vb = sbb - sb * sb / sw;
+        if (va > 0 && vb > 0) *zncc = (sab - sa * sb / sw) / sqrt(va * vb);
+    }
+    return n ? cost / n : INFINITY;
+}
+
+static double max_corner_distance(const solver *s, const double *h1, const double *h2)
+{
+    const double xs[2] = {0.0, 2.0 * s->cx}, ys[2] = {0.0, 2.0 * s->cy};
+    double worst = 0.0;
+    int k;
+    for (k = 0; k < 4; k++) {
+        double x = xs[k & 1], y = ys[k >> 1];
+        double w1 = h1[6] * x + h1[7] * y + h1[8], w2 = h2[6] * x + h2[7] * y + h2[8];
+        double dx = (h1[0] * x + h1[1] * y + h1[2]) / w1 - (h2[0] * x + h2[1] * y + h2[2]) / w2;
+        double dy = (h1[3] * x + h1[4] * y + h1[5]) / w1 - (h2[3] * x + h2[4] * y + h2[5]) / w2;
+        double d = sqrt(dx * dx + dy * dy);
+        if (!(d <= worst)) worst = d; /* NaN counts as infinitely far */
+    }
+    return worst;
+}
+
+/* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid.
+ * Writes the refined H and fills the refine fields of result. */
+static void refine(home_context *ctx, int slot, const double *h0, home_result *result)
+{
+    const home__refine_state *st = &ctx->refine;
+    solver s;
+    double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0;
+    int level, it, converged = 0, iterations = 0;
+    float *scratch = (float *)st->scratch;
+    const int cap = level_capacity(0);
+
+    memset(&s, 0, sizeof s);
+    s.st = st;
+    s.tpl = st->tpl[slot];
+    s.cx = 0.5 * (ctx->cfg.width - 1);
+    s.cy = 0.5 * (ctx->cfg.height - 1);
+    s.f = 0.5 * (ctx->cfg.width > ctx->cfg.height ? ctx->cfg.width : ctx->cfg.height);
+    s.img_b = scratch;
+    s.img_b2 = scratch + cap;
+    s.res = scratch + 2 * cap;
+    s.wt = scratch + 3 * cap;
+    s.alpha = 1.0;
+    to_normalised(&s, h0, hn0);
+    memcpy(s.hn, hn0, sizeof hn0);
+    for (level = 0; level < st->levels; level++) {
+        if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return; }
+    }
+    for (level = st->levels - 1; level >= 0; level--) {
+        converged = 0;
+        for (it = 0; it < ctx->cfg.refine_iterations; it++) {
+            iterations++;
+            if (!iterate(&s, level, &step)) {
+                result->refine_iterations = iterations;
+                result->refine_status = HOME_REFINE_FEW_POINTS;
+                return;
+            }
+            if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
+        }
+    }
+    result->refine_iterations = iterations;
+    if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return; }
+    to_pixels(&s, s.hn, h1);
+    if (corner_std_px(&s) > MAX_CORNER_STD_PX) {
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return;
+    }
+    if (max_corner_distance(&s, h1, h0) > ctx->cfg.refine_trust_px) {
+        result->refine_status = HOME_REFINE_OUTSIDE_TRUST;
+        return;
+    }
+    /* like for like: both estimates over the points both keep, at the scale of HOME's */
+    {
+        const home__refine_points *tp = &s.tpl[0];
+        float m[9];
+        level_matrix(&s, s.hn, 0, m);
+        home__refine_warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
+                          st->w[0], st->w[0], st->h[0], s.img_b2);
+        level_matrix(&s, hn0, 0, m);
+        home__refine_warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
+                          st->w[0], st->w[0], st->h[0], s.img_b);
+        s.alpha = 1.0;
+        s.beta = 0.0;
+        fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
+        sigma0 = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta);
+        e0 = photometric_error(&s, hn0, s.img_b2, sigma0, s.img_b, &zncc0);
+        level_matrix(&s, hn0, 0, m);
+        home__refine_warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
+                          st->w[0], st->w[0], st->h[0], s.img_b2);
+        e1 = photometric_error(&s, s.hn, s.img_b2, sigma0, s.img_b, &zncc1);
+    }
+    result->refine_error[0] = e0;
+    result->refine_error[1] = e1;
+    result->refine_zncc = zncc1;
+    if (!(e1 < e0)) { result->refine_status = HOME_REFINE_NOT_LOWER; return; }
+    memcpy(result->H, h1, sizeof h1);
+    result->refined = 1;
+    result->refine_status = HOME_REFINE_ACCEPTED;
+}
+
+static int find_slot(const home__refine_state *st, uint32_t id)
+{
+    if (!id) return -1;
+    if (st->slot_id[0] == id) return 0;
+    if (st->slot_id[1] == id) return 1;
+    return -1;
+}
+
+/* Failure rule with the refinement (documented in home.h): HOME ok, or HOME short of inliers
+ * (at least 8) but the refinement accepted with a correlation of at least 0.9. */
+void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
+{
+    home__refine_state *st = &ctx->refine;
+    home_result trial;
+    int slot;
+    double t0 = home__now(ctx);
+    result->refined = 0;
+    result->refine_status = HOME_REFINE_OFF;
+    if (!st->levels) return;
+    if (!result->ok && result->failure != HOME_FAIL_FEW_INLIERS) {
+        result->refine_status = HOME_REFINE_NO_ESTIMATE;
+        return;
+    }
+    slot = find_slot(st, id_a);
+    if (slot < 0 || st->pyr_id != id_b || !id_b) {
+        result->refine_status = HOME_REFINE_NO_SNAPSHOT;
+        return;
+    }
+    trial = *result;
+    refine(ctx, slot, result->H, &trial);
+    if (!result->ok && trial.refined && !(trial.refine_zncc >= 0.9 && result->inliers >= 8)) {
+        trial.refined = 0;
+        trial.refine_status = HOME_REFINE_LOW_CORRELATION;
+        memcpy(trial.H, result->H, sizeof trial.H);
+    } else if (!result->ok && trial.refined) {
+        trial.ok = 1;
+        trial.failure = HOME_FAIL_NONE;
+    }
+    *result = trial;
+    result->ms[HOME_STAGE_REFINE] += home__now(ctx) - t0;
+}
+
+int home_refine(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const uint8_t *b,
+                ptrdiff_t stride_b, const double *h_init, home_result *result)
+{
+    double t0;
+    uint32_t id_a, id_b;
+    int k, status;
+    if (!ctx || !result || !h_init) return HOME_E_NULL;
+    if (ctx->magic != HOME__MAGIC_CTX) return HOME_E_STATE;
+    if ((status = home__check_image(ctx, a, stride_a)) != HOME_OK) return status;
+    if ((status = home__check_image(ctx, b, stride_b)) != HOME_OK) return status;
+    for (k = 0; k < 9; k++)
+        if (!isfinite(h_init[k])) return HOME_E_CONFIG;
+    if (!(fabs(h_init[8]) > 1e-12)) return HOME_E_CONFIG;
+    memset(result, 0, sizeof *result);
+    for (k = 0; k < 9; k++) result->H[k] = h_init[k] / h_init[8];
+    result->ok = 1;
+    t0 = home__now(ctx);
+    id_a = home__refine_store(ctx, a, stride_a);
+    id_b = home__refine_store(ctx, b, stride_b);
+    result->ms[HOME_STAGE_REFINE] = home__now(ctx) - t0;
+    home__refine_apply(ctx, id_a, id_b, result);
+    result->ok = result->refined;
+    result->ms[HOME_STAGE_TOTAL] = result->ms[HOME_STAGE_REFINE];
+    return HOME_OK;
+}

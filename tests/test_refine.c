@@ -1,0 +1,461 @@
+/* Photometric refinement (src/refine.c): accuracy on known homographies, robustness (occluder,
+ * gain change), the safeguards (textureless, iteration cap, trust region), the failure rule,
+ * video == pair, the kernels against plain references, arena size and bad inputs.
+ * Prints "N passed, N failed" last; `home-refine-tests NAME...` runs a subset. */
+#include "test.h"
+#include "synth.h"
+#include "home_internal.h"
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+int test_failures;
+
+#define IMG_W 640
+#define IMG_H 360
+static uint8_t img_a[IMG_W * IMG_H], img_b[IMG_W * IMG_H];
+static home_features fa, fb;
+static union { unsigned char bytes[2u << 20]; double align; } arena;
+static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+static home_context *context(const home_config *override_cfg)
+{
+    home_config cfg;
+    home_context *ctx = NULL;
+    if (override_cfg) cfg = *override_cfg;
+    else home_default_config(&cfg, IMG_W, IMG_H);
+    if (home_init(&ctx, &cfg, arena.bytes, sizeof arena.bytes, NULL) != HOME_OK) return NULL;
+    return ctx;
+}
+
+/* A band-limited texture: a sum of plane waves (wavelengths 7..60 px), analytic so any
+ * homography renders it exactly. */
+typedef struct texture { double kx[16], ky[16], phase[16], amp[16]; } texture;
+
+static void make_texture(texture *t, uint64_t seed)
+{
+    synth_rng rng;
+    int k;
+    synth_seed(&rng, seed);
+    for (k = 0; k < 16; k++) {
+        double ang = synth_uniform(&rng) * 3.14159265358979, lambda = 7.0 + 53.0 * synth_uniform(&rng);
+        t->kx[k] = 2 * 3.14159265358979 / lambda * cos(ang);
+        t->ky[k] = 2 * 3.14159265358979 / lambda * sin(ang);
+        t->phase[k] = 6.28318530717959 * synth_uniform(&rng);
+        t->amp[k] = 6.0 + 8.0 * synth_uniform(&rng);
+    }
+}
+
+/* Render texture seen through h (scene -> image), times gain, plus noise. */
+static void render_texture(const texture *t, const double *h, double gain, double noise,
+                           uint64_t seed, uint8_t *out)
+{
+    double inv[9];
+    synth_rng rng;
+    int x, y, k;
+    synth_invert(h, inv);
+    synth_seed(&rng, seed);
+    for (y = 0; y < IMG_H; y++) {
+        for (x = 0; x < IMG_W; x++) {
+            double sx, sy, v = 128.0;
+            synth_apply(inv, x, y, &sx, &sy);
+            for (k = 0; k < 16; k++) v += t->amp[k] * sin(t->kx[k] * sx + t->ky[k] * sy + t->phase[k]);
+            v = gain * v + noise * synth_gauss(&rng);
+            out[y * IMG_W + x] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : floor(v + 0.5));
+        }
+    }
+}
+
+/* h_true composed with a random corner perturbation of up to p px: a start like HOME's. */
+static void perturbed(const double *h_true, double p, uint64_t seed, double *h_out)
+{
+    double dh[9], t[9];
+    synth_rng rng;
+    int i, j, k;
+    synth_seed(&rng, seed);
+    synth_corner_homography(&rng, IMG_W, IMG_H, p, dh);
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            t[i * 3 + j] = 0;
+            for (k = 0; k < 3; k++) t[i * 3 + j] += dh[i * 3 + k] * h_true[k * 3 + j];
+        }
+    for (k = 0; k < 9; k++) h_out[k] = t[k] / t[8];
+}
+
+static void textured_pair(uint64_t seed, double p, double gain, double *h)
+{
+    texture t;
+    synth_rng rng;
+    make_texture(&t, seed);
+    synth_seed(&rng, seed);
+    synth_corner_homography(&rng, IMG_W, IMG_H, p, h);
+    render_texture(&t, identity, 1.0, 2.5, 2 * seed + 1, img_a);
+    render_texture(&t, h, gain, 2.5, 2 * seed + 2, img_b);
+}
+
+static void structured_pair(uint64_t seed, double p, double *h)
+{
+    synth_rng rng;
+    synth_seed(&rng, seed);
+    synth_corner_homography(&rng, IMG_W, IMG_H, p, h);
+    synth_render(SYNTH_STRUCTURED, (uint32_t)seed, identity, 2.5, 2 * seed + 1, img_a, IMG_W, IMG_H, IMG_W);
+    synth_render(SYNTH_STRUCTURED, (uint32_t)seed, h, 2.5, 2 * seed + 2, img_b, IMG_W, IMG_H, IMG_W);
+}
+
+/* Refine from a start `p_start` px off and return the corner error; checks acceptance. */
+static double refine_from(home_context *ctx, const double *h, double p_start, uint64_t seed,
+                          home_result *res)
+{
+    double h0[9];
+    perturbed(h, p_start, seed, h0);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h0, res), HOME_OK);
+    return synth_corner_error(res->H, h, IMG_W, IMG_H);
+}
+
+void test_textured_subpixel(void)
+{
+    home_context *ctx = context(NULL);
+    int k;
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 3; k++) {
+        double h[9], err;
+        home_result res;
+        textured_pair(100 + k, 10 + 15 * k, 1.0, h);
+        err = refine_from(ctx, h, 2.0, 7 + k, &res);
+        printf("     textured p=%d: start 2 px off -> %.3f px, status %d, %d iterations\n",
+               10 + 15 * k, err, res.refine_status, res.refine_iterations);
+        CHECK(res.refined);
+        CHECK_LT(err, 0.1);
+    }
+}
+
+void test_lines_subpixel(void)
+{
+    home_context *ctx = context(NULL);
+    int k;
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 3; k++) {
+        double h[9], err;
+        home_result res;
+        structured_pair(200 + k, 10 + 15 * k, h);
+        err = refine_from(ctx, h, 1.5, 17 + k, &res);
+        printf("     line-only p=%d: start 1.5 px off -> %.3f px, status %d\n", 10 + 15 * k, err,
+               res.refine_status);
+        CHECK(res.refined);
+        CHECK_LT(err, 0.5);
+    }
+}
+
+void test_moving_occluder(void)
+{
+    /* a textured block of 20 % of the frame pasted into B only (it moved in from elsewhere) */
+    home_context *ctx = context(NULL);
+    double h[9], err;
+    home_result res;
+    synth_rng rng;
+    int x, y, x0 = 150, y0 = 100, bw = 256, bh = 180; /* 256 * 180 = 20 % of 640 * 360 */
+    if (!ctx) { CHECK(0); return; }
+    textured_pair(300, 20, 1.0, h);
+    synth_seed(&rng, 301);
+    for (y = y0; y < y0 + bh; y++)
+        for (x = x0; x < x0 + bw; x++)
+            img_b[y * IMG_W + x] = (uint8_t)(((x / 12 + y / 9) & 1) ? 230 : 20) + (uint8_t)(synth_uniform(&rng) * 10);
+    err = refine_from(ctx, h, 2.0, 31, &res);
+    printf("     occluder 20 %%: %.3f px, status %d\n", err, res.refine_status);
+    CHECK(res.refined);
+    CHECK_LT(err, 0.1);
+}
+
+void test_gain_change(void)
+{
+    home_context *ctx = context(NULL);
+    const double gains[2] = {1.3, 0.7};
+    int k;
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 2; k++) {
+        double h[9], err;
+        home_result res;
+        textured_pair(400 + k, 20, gains[k], h);
+        err = refine_from(ctx, h, 2.0, 41 + k, &res);
+        printf("     gain x%.1f: %.3f px, status %d\n", gains[k], err, res.refine_status);
+        CHECK(res.refined);
+        CHECK_LT(err, 0.1);
+    }
+}
+
+void test_textureless_declines(void)
+{
+    /* smooth shading and noise only: nothing to align, the start must come back untouched */
+    home_context *ctx = context(NULL);
+    double h[9], h0[9];
+    home_result res;
+    synth_rng rng;
+    int x, y;
+    if (!ctx) { CHECK(0); return; }
+    synth_seed(&rng, 5);
+    synth_corner_homography(&rng, IMG_W, IMG_H, 15, h);
+    for (y = 0; y < IMG_H; y++)
+        for (x = 0; x < IMG_W; x++) {
+            double sx, sy, inv[9];
+            img_a[y * IMG_W + x] = (uint8_t)(100 + 0.05 * x + 0.04 * y + 2.5 * synth_gauss(&rng));
+            synth_invert(h, inv);
+            synth_apply(inv, x, y, &sx, &sy);
+            img_b[y * IMG_W + x] = (uint8_t)(100 + 0.05 * sx + 0.04 * sy + 2.5 * synth_gauss(&rng));
+        }
+    perturbed(h, 1.5, 9, h0);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h0, &res), HOME_OK);
+    CHECK(!res.refined);
+    CHECK(res.refine_status != HOME_REFINE_ACCEPTED);
+    CHECK(memcmp(res.H, h0, sizeof h0) == 0);
+    /* a flat grey pair */
+    memset(img_a, 128, sizeof img_a);
+    memset(img_b, 128, sizeof img_b);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h0, &res), HOME_OK);
+    CHECK_EQ_INT(res.refine_status, HOME_REFINE_FEW_POINTS);
+    CHECK(memcmp(res.H, h0, sizeof h0) == 0);
+}
+
+void test_iteration_cap_keeps_start(void)
+{
+    home_config cfg;
+    home_context *ctx;
+    double h[9], h0[9];
+    home_result res;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.refine_iterations = 1;
+    ctx = context(&cfg);
+    if (!ctx) { CHECK(0); return; }
+    textured_pair(500, 20, 1.0, h);
+    perturbed(h, 3.0, 51, h0);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h0, &res), HOME_OK);
+    CHECK_EQ_INT(res.refine_status, HOME_REFINE_NOT_CONVERGED);
+    CHECK(!res.refined);
+    CHECK(memcmp(res.H, h0, sizeof h0) == 0);
+}
+
+void test_trust_region(void)
+{
+    /* the same start converges, but the corners must move ~3 px: a 1 px trust region refuses */
+    home_config cfg;
+    home_context *ctx;
+    double h[9], h0[9];
+    home_result res;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.refine_trust_px = 1.0f;
+    ctx = context(&cfg);
+    if (!ctx) { CHECK(0); return; }
+    textured_pair(600, 20, 1.0, h);
+    perturbed(h, 3.0, 61, h0);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h0, &res), HOME_OK);
+    CHECK_EQ_INT(res.refine_status, HOME_REFINE_OUTSIDE_TRUST);
+    CHECK(memcmp(res.H, h0, sizeof h0) == 0);
+}
+
+void test_video_equals_pair(void)
+{
+    home_context *ctx = context(NULL);
+    home_result pair, video;
+    double h[9];
+    if (!ctx) { CHECK(0); return; }
+    structured_pair(700, 20, h);
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &pair), HOME_OK);
+    CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &fa), HOME_OK);
+    CHECK_EQ_INT(home_extract(ctx, img_b, IMG_W, &fb), HOME_OK);
+    CHECK_EQ_INT(home_match(ctx, &fa, &fb, &video), HOME_OK);
+    CHECK(pair.ok && video.ok && pair.refined && video.refined);
+    CHECK(memcmp(pair.H, video.H, sizeof pair.H) == 0);
+    /* b is not the newest frame: no snapshot, HOME's IMG_H, not an error */
+    CHECK_EQ_INT(home_match(ctx, &fb, &fa, &video), HOME_OK);
+    CHECK_EQ_INT(video.refine_status, HOME_REFINE_NO_SNAPSHOT);
+    CHECK(!video.refined);
+}
+
+void test_refinement_improves_home(void)
+{
+    /* end to end: HOME then refinement on line-only scenes never loses more than 0.5 px and
+     * lands within 0.5 px */
+    home_config cfg;
+    home_context *ctx;
+    int k;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    for (k = 0; k < 3; k++) {
+        double h[9], e_home, e_ref;
+        home_result r0, r1;
+        structured_pair(800 + k, 10 + 20 * k, h);
+        cfg.refine_levels = 0;
+        ctx = context(&cfg);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &r0), HOME_OK);
+        cfg.refine_levels = 3;
+        ctx = context(&cfg);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &r1), HOME_OK);
+        e_home = synth_corner_error(r0.H, h, IMG_W, IMG_H);
+        e_ref = synth_corner_error(r1.H, h, IMG_W, IMG_H);
+        printf("     structured p=%d: HOME %.3f px -> refined %.3f px (%s)\n", 10 + 20 * k, e_home,
+               e_ref, r1.refined ? "accepted" : "declined");
+        CHECK(r0.ok && r1.ok);
+        CHECK_EQ_INT(r0.refine_status, HOME_REFINE_OFF);
+        CHECK_LT(e_ref, e_home + 0.5);
+        CHECK_LT(e_ref, 0.5);
+    }
+}
+
+void test_failure_rule_rescue(void)
+{
+    /* HOME short of inliers (min_inliers above what any pair has) on a good pair: the accepted
+     * refinement with a high correlation makes it ok; without refinement it stays a failure */
+    home_config cfg;
+    home_context *ctx;
+    home_result res;
+    double h[9];
+    synth_rng rng;
+    int i;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.min_inliers = 2 * HOME_MAX_KEYPOINTS_PER_SIGN;
+    structured_pair(900, 20, h);
+    ctx = context(&cfg);
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+    CHECK(res.ok && res.refined && res.failure == HOME_FAIL_NONE);
+    CHECK(res.inliers >= 8 && res.inliers < cfg.min_inliers);
+    CHECK(res.refine_zncc >= 0.9);
+    CHECK_LT(synth_corner_error(res.H, h, IMG_W, IMG_H), 0.5);
+    cfg.refine_levels = 0;
+    ctx = context(&cfg);
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+    CHECK(!res.ok && res.failure == HOME_FAIL_FEW_INLIERS);
+    /* noise against other noise is never rescued */
+    cfg.refine_levels = 3;
+    cfg.min_inliers = 20;
+    ctx = context(&cfg);
+    synth_seed(&rng, 5);
+    for (i = 0; i < IMG_W * IMG_H; i++) {
+        img_a[i] = (uint8_t)(synth_uniform(&rng) * 256);
+        img_b[i] = (uint8_t)(synth_uniform(&rng) * 256);
+    }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+    CHECK(!res.ok && !res.refined);
+}
+
+void test_kernels_match_references(void)
+{
+    /* downsample: rounded 2x2 mean; warp: bilinear at exact integer shifts; accumulate: the
+     * double-precision normal equations */
+    static uint8_t src[37 * 23], dst[18 * 11];
+    static int16_t xs[64], ys[64], gx[64], gy[64];
+    static float r[64], w[64], out[64], acc[44 * 4];
+    const float m[9] = {1, 0, 2, 0, 1, 3, 0, 0, 1}, aff[3] = {0.01f, -0.3f, -0.2f};
+    synth_rng rng;
+    int i, j, x, y, bad = 0;
+    double ref[44];
+    synth_seed(&rng, 77);
+    for (i = 0; i < (int)sizeof src; i++) src[i] = (uint8_t)(synth_uniform(&rng) * 256);
+    home__refine_downsample(src, 37, dst, 18, 18, 11);
+    for (y = 0; y < 11; y++)
+        for (x = 0; x < 18; x++) {
+            int s = src[2 * y * 37 + 2 * x] + src[2 * y * 37 + 2 * x + 1] +
+                    src[(2 * y + 1) * 37 + 2 * x] + src[(2 * y + 1) * 37 + 2 * x + 1];
+            bad += dst[y * 18 + x] != (uint8_t)((s + 2) / 4);
+        }
+    CHECK_EQ_INT(bad, 0);
+    for (i = 0; i < 64; i++) {
+        xs[i] = (int16_t)(i % 40 - 3);
+        ys[i] = (int16_t)(i / 3);
+        gx[i] = (int16_t)(synth_uniform(&rng) * 400 - 200);
+        gy[i] = (int16_t)(synth_uniform(&rng) * 400 - 200);
+        r[i] = (float)(synth_uniform(&rng) * 20 - 10);
+        w[i] = (float)synth_uniform(&rng);
+    }
+    home__refine_warp(m, xs, ys, 64, src, 37, 37, 23, out);
+    for (i = 0, bad = 0; i < 64; i++) {
+        int px = xs[i] + 2, py = ys[i] + 3;
+        float expect = (px >= 0 && py >= 0 && px < 36 && py < 22) ? (float)src[py * 37 + px] : -1.0f;
+        bad += out[i] != expect;
+    }
+    CHECK_EQ_INT(bad, 0);
+    home__refine_accumulate(xs, ys, gx, gy, r, w, 64, aff, acc);
+    memset(ref, 0, sizeof ref);
+    for (i = 0; i < 64; i++) {
+        double u = aff[0] * (double)xs[i] + aff[1], v = aff[0] * (double)ys[i] + aff[2], g = gx[i] * u + gy[i] * v;
+        double sd[8];
+        int k = 0;
+        sd[0] = gx[i] * u; sd[1] = gx[i] * v; sd[2] = gx[i]; sd[3] = gy[i] * u; sd[4] = gy[i] * v;
+        sd[5] = gy[i]; sd[6] = -u * g; sd[7] = -v * g;
+        for (j = 0; j < 8; j++) {
+            int q;
+            for (q = j; q < 8; q++) ref[k++] += w[i] * sd[j] * sd[q];
+            ref[36 + j] += w[i] * sd[j] * r[i];
+        }
+    }
+    for (j = 0, bad = 0; j < 44; j++) {
+        double s = (double)acc[j * 4] + acc[j * 4 + 1] + acc[j * 4 + 2] + acc[j * 4 + 3];
+        bad += fabs(s - ref[j]) > 1e-4 * (fabs(ref[j]) + 1.0);
+    }
+    CHECK_EQ_INT(bad, 0);
+}
+
+void test_arena_and_config(void)
+{
+    home_config cfg, bad;
+    size_t with, without;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    CHECK_EQ_INT(cfg.refine_levels, 3);
+    with = home_arena_size(&cfg);
+    bad = cfg;
+    bad.refine_levels = 0;
+    without = home_arena_size(&bad);
+    printf("     arena at 640x360: %zu bytes with refinement, %zu without\n", with, without);
+    CHECK(with <= (size_t)2 << 20);
+    CHECK(with > without);
+    bad = cfg; bad.refine_levels = HOME_REFINE_MAX_LEVELS + 1; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.refine_levels = -1; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.refine_iterations = 0; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.refine_trust_px = (float)NAN; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.refine_levels = 0; bad.refine_iterations = 0; CHECK_EQ_INT(home_validate_config(&bad), HOME_OK);
+    /* smallest images still get a usable pyramid */
+    CHECK_EQ_INT(home_default_config(&cfg, HOME_MIN_SIDE, HOME_MIN_SIDE), HOME_OK);
+    CHECK(home_arena_size(&cfg) > 0);
+}
+
+void test_refine_bad_inputs(void)
+{
+    home_context *ctx = context(NULL);
+    home_result res;
+    double h[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    if (!ctx) { CHECK(0); return; }
+    memset(img_a, 90, sizeof img_a);
+    CHECK_EQ_INT(home_refine(NULL, img_a, IMG_W, img_b, IMG_W, h, &res), HOME_E_NULL);
+    CHECK_EQ_INT(home_refine(ctx, NULL, IMG_W, img_b, IMG_W, h, &res), HOME_E_NULL);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, NULL, &res), HOME_E_NULL);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h, NULL), HOME_E_NULL);
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W - 1, img_b, IMG_W, h, &res), HOME_E_STRIDE);
+    h[4] = NAN;
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h, &res), HOME_E_CONFIG);
+    h[4] = 1; h[8] = 0;
+    CHECK_EQ_INT(home_refine(ctx, img_a, IMG_W, img_b, IMG_W, h, &res), HOME_E_CONFIG);
+}
+
+#define TEST_LIST(X) \
+    X(kernels_match_references) X(arena_and_config) X(textured_subpixel) X(lines_subpixel) \
+    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) \
+    X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
+    X(refine_bad_inputs)
+
+#define ENTRY(name) {#name, test_##name},
+static const struct { const char *name; void (*fn)(void); } tests[] = {TEST_LIST(ENTRY)};
+
+int main(int argc, char **argv)
+{
+    int passed = 0, failed = 0;
+    size_t i;
+    for (i = 0; i < sizeof tests / sizeof tests[0]; i++) {
+        int before = test_failures, k, selected = argc < 2;
+        for (k = 1; k < argc; k++) selected |= !strcmp(argv[k], tests[i].name);
+        if (!selected) continue;
+        tests[i].fn();
+        if (test_failures == before) { passed++; printf("ok   %s\n", tests[i].name); }
+        else { failed++; printf("FAIL %s\n", tests[i].name); }
+        fflush(stdout);
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
