@@ -41,6 +41,7 @@ $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_inte
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_LIB) -c $< -o $@
 
+$(BUILD)/obj/port/avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 $(BUILD)/obj/port/%.o: port/%.c include/home.h include/home_limits.h port/kernels.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_LIB) -c $< -o $@

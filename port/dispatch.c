@@ -13,6 +13,12 @@ const home__kernels *home__kernels_for(int simd)
 #else
         return NULL;
 #endif
+    case HOME_SIMD_AVX2:
+#ifdef HOME__HAVE_AVX2
+        return __builtin_cpu_supports("avx2") ? &home__kernels_avx2 : NULL;
+#else
+        return NULL;
+#endif
     case HOME_SIMD_NEON:
 #ifdef HOME__HAVE_NEON
         return &home__kernels_neon;
@@ -22,6 +28,8 @@ const home__kernels *home__kernels_for(int simd)
     case HOME_SIMD_AUTO:
 #if defined(HOME__HAVE_NEON)
         return &home__kernels_neon;
+#elif defined(HOME__HAVE_AVX2)
+        return __builtin_cpu_supports("avx2") ? &home__kernels_avx2 : &home__kernels_sse;
 #elif defined(HOME__HAVE_SSE)
         return &home__kernels_sse;
 #else

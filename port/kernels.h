@@ -40,6 +40,17 @@ extern const home__kernels home__kernels_scalar;
 #if defined(__SSE2__)
 #define HOME__HAVE_SSE 1
 extern const home__kernels home__kernels_sse;
+/* shared by the AVX2 table, which only replaces the Radon kernel */
+void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
+                           int *best, int *d1, int *d2);
+void home__smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius);
+void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
+                           int radius);
+#endif
+#if defined(__x86_64__) && !defined(HOME_NO_AVX2)
+/* port/avx2.c is compiled with -mavx2 and used only when the CPU reports AVX2 */
+#define HOME__HAVE_AVX2 1
+extern const home__kernels home__kernels_avx2;
 #endif
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #define HOME__HAVE_NEON 1

@@ -36,7 +36,7 @@ static void radon_blocks_sse(const uint8_t *base, ptrdiff_t stride, const int16_
     }
 }
 
-static void nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
+void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
                             int *best, int *d1, int *d2)
 {
     const __m128i q = _mm_loadu_si128((const __m128i *)(const void *)query);
@@ -52,7 +52,7 @@ static void nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_
 }
 
 /* Same multiply-then-add order as the scalar reference, 4 outputs at a time: bit-identical. */
-static void smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius)
+void home__smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius)
 {
     int i = radius, k;
     for (; i + 4 <= n - radius; i += 4) {
@@ -65,7 +65,7 @@ static void smooth_row_sse(const float *in, float *out, int n, const float *taps
     home__kernels_scalar.smooth_row(in + i - radius, out + i - radius, n - i + radius, taps, radius);
 }
 
-static void smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
+void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
                             int radius)
 {
     int i = 0, k;
@@ -82,8 +82,8 @@ static void smooth_cols_sse(const float *const *rows, float *out, int n, const f
     }
 }
 
-const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, nearest2_l1_sse, smooth_row_sse,
-                                         smooth_cols_sse};
+const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, home__nearest2_l1_sse,
+                                         home__smooth_row_sse, home__smooth_cols_sse};
 #else
 typedef int home__sse_unavailable; /* ISO C forbids an empty translation unit */
 #endif

@@ -10,6 +10,10 @@ ARCH_FLAGS ?=
 QEMU ?= qemu-aarch64-static -L /usr/aarch64-linux-gnu
 endif
 ARCH_FLAGS ?=
+# x86-64: the AVX2 kernels get their own flags; the rest of the library stays at the SSE2 baseline
+ifneq (,$(findstring x86_64,$(TARGET_TRIPLE)))
+AVX2_FLAGS := -mavx2
+endif
 # Cross builds run their test binaries under qemu-user unless RUNNER is given.
 ifneq ($(CROSS_COMPILE),)
 RUNNER ?= $(QEMU)

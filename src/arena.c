@@ -46,6 +46,7 @@ int home_default_config(home_config *cfg, int width, int height)
         if (env && !strcmp(env, "none")) cfg->simd = HOME_SIMD_NONE;
         else if (env && !strcmp(env, "sse")) cfg->simd = HOME_SIMD_SSE;
         else if (env && !strcmp(env, "neon")) cfg->simd = HOME_SIMD_NEON;
+        else if (env && !strcmp(env, "avx2")) cfg->simd = HOME_SIMD_AVX2;
     }
 #endif
     if (width < HOME_MIN_SIDE || height < HOME_MIN_SIDE || width > HOME_MAX_SIDE ||

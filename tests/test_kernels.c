@@ -7,7 +7,7 @@
 #include <math.h>
 #include <string.h>
 
-static const int backends[] = {HOME_SIMD_SSE, HOME_SIMD_NEON};
+static const int backends[] = {HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
 
 static uint8_t random_byte(synth_rng *rng, int extreme)
 {

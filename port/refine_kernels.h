@@ -1,0 +1,53 @@
+/* Kernels of the photometric refinement (src/refine.c): one table per SIMD backend, chosen per
+ * context like home__kernels. Integer kernels are bit-identical to the scalar reference; the
+ * float kernels are too, because every backend runs the same IEEE operations in the same order
+ * on the same lane (point i is lane i % 4; no fused multiply-add, C99 contracts none), which
+ * tests/test_refine.c checks on odd sizes and unaligned pointers. */
+#ifndef HOME_REFINE_KERNELS_H
+#define HOME_REFINE_KERNELS_H
+#include <stddef.h>
+#include <stdint.h>
+
+#define HOME__REFINE_LANES 4
+#define HOME__REFINE_ACC 44   /* 36 upper-triangle entries of J^T W J, then 8 of J^T W r */
+
+typedef struct home__refine_kernels {
+    const char *name;
+    /* 3x3 binomial blur ([1 2 1] / 4 both ways, one rounding: (sum + 8) >> 4), edges
+     * replicated; w >= 2; tmp holds w int16. */
+    void (*blur3)(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst, ptrdiff_t dst_stride,
+                  int w, int h, int16_t *tmp);
+    /* 2x2 mean with rounding ((a + b + c + d + 2) >> 2) into dst_w x dst_h. */
+    void (*downsample)(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                       ptrdiff_t dst_stride, int dst_w, int dst_h);
+    /* Selection keys of one row (rows above and below must exist): for 1 <= x <= w - 2,
+     * key = (|P[x+1] - P[x-1]| + |P[x+stride] - P[x-stride]|) << 4 | (dy * b + (x & (b - 1)))
+     * stored into keys[x] (accumulate == 0) or maxed into it; keys[0] and keys[w-1] are set
+     * to 0 when storing. b is 1, 2 or 4. */
+    void (*select_keys)(const uint8_t *row, ptrdiff_t stride, int w, int b, int dy,
+                        int16_t *keys, int accumulate);
+    /* Bilinear samples at m * (x, y, 1) after the perspective divide, -1 where the point maps
+     * behind the camera or its 2x2 support leaves the w x h image. n is a multiple of 4. */
+    void (*warp)(const float *m, const int16_t *xs, const int16_t *ys, int n, const uint8_t *img,
+                 ptrdiff_t stride, int w, int h, float *out);
+    /* Weighted normal equations of one inverse-compositional step, per lane:
+     * acc[k * 4 + lane], k < 36 the upper triangle of sum w sd sd^T, k = 36 + j sum w r sd_j,
+     * sd = (gx u, gx v, gx, gy u, gy v, gy, -(u g), -(v g)), g = gx u + gy v,
+     * u = aff[0] x + aff[1], v = aff[0] y + aff[2]; ws = w sd_p then += ws sd_q; wr = w r then
+     * += sd_j wr. n is a multiple of 4. */
+    void (*accumulate)(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
+                       const int16_t *gys, const float *r, const float *w, int n,
+                       const float *aff, float *acc);
+} home__refine_kernels;
+
+extern const home__refine_kernels home__refine_kernels_scalar;
+#if defined(__SSE2__)
+extern const home__refine_kernels home__refine_kernels_sse;
+#endif
+#if defined(__ARM_NEON) || defined(__ARM_NEON__)
+extern const home__refine_kernels home__refine_kernels_neon;
+#endif
+
+/* The table for a home_simd value (AUTO: the best compiled in), NULL when not compiled in. */
+const home__refine_kernels *home__refine_kernels_for(int simd);
+#endif

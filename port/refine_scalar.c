@@ -1,0 +1,93 @@
+/* Scalar reference kernels of the refinement: the definition every SIMD backend reproduces. */
+#include "refine_kernels.h"
+#include <string.h>
+
+static void blur3_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                         ptrdiff_t dst_stride, int w, int h, int16_t *tmp)
+{
+    int x, y;
+    for (y = 0; y < h; y++) {
+        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
+        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
+        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
+        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        for (x = 0; x < w; x++) tmp[x] = (int16_t)(a[x] + 2 * b[x] + c[x]);
+        d[0] = (uint8_t)((3 * tmp[0] + tmp[1] + 8) >> 4);
+        for (x = 1; x < w - 1; x++) d[x] = (uint8_t)((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
+        d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
+    }
+}
+
+static void downsample_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                              ptrdiff_t dst_stride, int dst_w, int dst_h)
+{
+    int x, y;
+    for (y = 0; y < dst_h; y++) {
+        const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
+        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        for (x = 0; x < dst_w; x++)
+            d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
+    }
+}
+
+static void select_keys_scalar(const uint8_t *row, ptrdiff_t stride, int w, int b, int dy,
+                               int16_t *keys, int accumulate)
+{
+    int x;
+    if (!accumulate) keys[0] = keys[w - 1] = 0;
+    for (x = 1; x < w - 1; x++) {
+        int gx = row[x + 1] - row[x - 1], gy = row[x + stride] - row[x - stride];
+        int key = ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)) << 4 | (dy * b + (x & (b - 1)));
+        if (!accumulate || key > keys[x]) keys[x] = (int16_t)key;
+    }
+}
+
+static void warp_scalar(const float *m, const int16_t *xs, const int16_t *ys, int n,
+                        const uint8_t *img, ptrdiff_t stride, int w, int h, float *out)
+{
+    const float xmax = (float)(w - 1), ymax = (float)(h - 1);
+    int i;
+    for (i = 0; i < n; i++) {
+        float x = (float)xs[i], y = (float)ys[i];
+        float d = m[6] * x + m[7] * y + m[8];
+        float px = (m[0] * x + m[1] * y + m[2]) / d;
+        float py = (m[3] * x + m[4] * y + m[5]) / d;
+        if (d > 0.0f && px >= 0.0f && py >= 0.0f && px < xmax && py < ymax) {
+            int ix = (int)px, iy = (int)py;
+            float fx = px - (float)ix, fy = py - (float)iy;
+            const uint8_t *p = img + (ptrdiff_t)iy * stride + ix;
+            float p00 = (float)p[0], p01 = (float)p[1], p10 = (float)p[stride], p11 = (float)p[stride + 1];
+            float top = p00 + fx * (p01 - p00);
+            float bot = p10 + fx * (p11 - p10);
+            out[i] = top + fy * (bot - top);
+        } else {
+            out[i] = -1.0f;
+        }
+    }
+}
+
+static void accumulate_scalar(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
+                              const int16_t *gys, const float *r, const float *w, int n,
+                              const float *aff, float *acc)
+{
+    int i, p, q, k;
+    memset(acc, 0, HOME__REFINE_ACC * HOME__REFINE_LANES * sizeof *acc);
+    for (i = 0; i < n; i++) {
+        const int lane = i & (HOME__REFINE_LANES - 1);
+        float u = aff[0] * (float)xs[i] + aff[1], v = aff[0] * (float)ys[i] + aff[2];
+        float gx = (float)gxs[i], gy = (float)gys[i];
+        float g = gx * u + gy * v;
+        float sd[8], wr = w[i] * r[i];
+        sd[0] = gx * u; sd[1] = gx * v; sd[2] = gx;
+        sd[3] = gy * u; sd[4] = gy * v; sd[5] = gy;
+        sd[6] = -(u * g); sd[7] = -(v * g);
+        for (p = 0, k = 0; p < 8; p++) {
+            float ws = w[i] * sd[p];
+            for (q = p; q < 8; q++, k++) acc[k * HOME__REFINE_LANES + lane] += ws * sd[q];
+            acc[(36 + p) * HOME__REFINE_LANES + lane] += sd[p] * wr;
+        }
+    }
+}
+
+const home__refine_kernels home__refine_kernels_scalar = {
+    "none", blur3_scalar, downsample_scalar, select_keys_scalar, warp_scalar, accumulate_scalar};

@@ -1,0 +1,171 @@
+/* SSE2 kernels of the refinement (x86-64 baseline): bit-identical to port/refine_scalar.c. */
+#include "refine_kernels.h"
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <string.h>
+
+static __m128i load8_u16(const uint8_t *p)
+{
+    return _mm_unpacklo_epi8(_mm_loadl_epi64((const __m128i *)(const void *)p), _mm_setzero_si128());
+}
+
+static void blur3_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst, ptrdiff_t dst_stride,
+                      int w, int h, int16_t *tmp)
+{
+    const __m128i eight = _mm_set1_epi16(8);
+    int x, y;
+    for (y = 0; y < h; y++) {
+        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
+        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
+        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
+        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        for (x = 0; x + 8 <= w; x += 8) {
+            __m128i vb = load8_u16(b + x);
+            __m128i s = _mm_add_epi16(_mm_add_epi16(load8_u16(a + x), load8_u16(c + x)), _mm_add_epi16(vb, vb));
+            _mm_storeu_si128((__m128i *)(void *)(tmp + x), s);
+        }
+        for (; x < w; x++) tmp[x] = (int16_t)(a[x] + 2 * b[x] + c[x]);
+        d[0] = (uint8_t)((3 * tmp[0] + tmp[1] + 8) >> 4);
+        for (x = 1; x + 8 <= w - 1; x += 8) {
+            __m128i l = _mm_loadu_si128((const __m128i *)(const void *)(tmp + x - 1));
+            __m128i m = _mm_loadu_si128((const __m128i *)(const void *)(tmp + x));
+            __m128i r = _mm_loadu_si128((const __m128i *)(const void *)(tmp + x + 1));
+            __m128i s = _mm_add_epi16(_mm_add_epi16(l, r), _mm_add_epi16(m, m));
+            s = _mm_srli_epi16(_mm_add_epi16(s, eight), 4);
+            _mm_storel_epi64((__m128i *)(void *)(d + x), _mm_packus_epi16(s, s));
+        }
+        for (; x < w - 1; x++) d[x] = (uint8_t)((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
+        d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
+    }
+}
+
+static void downsample_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                           ptrdiff_t dst_stride, int dst_w, int dst_h)
+{
+    const __m128i lo = _mm_set1_epi16(0xff), two = _mm_set1_epi16(2);
+    int x, y;
+    for (y = 0; y < dst_h; y++) {
+        const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
+        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        for (x = 0; x + 8 <= dst_w; x += 8) {
+            __m128i va = _mm_loadu_si128((const __m128i *)(const void *)(a + 2 * x));
+            __m128i vb = _mm_loadu_si128((const __m128i *)(const void *)(b + 2 * x));
+            __m128i s = _mm_add_epi16(_mm_add_epi16(_mm_and_si128(va, lo), _mm_srli_epi16(va, 8)),
+                                      _mm_add_epi16(_mm_and_si128(vb, lo), _mm_srli_epi16(vb, 8)));
+            s = _mm_srli_epi16(_mm_add_epi16(s, two), 2);
+            _mm_storel_epi64((__m128i *)(void *)(d + x), _mm_packus_epi16(s, s));
+        }
+        for (; x < dst_w; x++)
+            d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
+    }
+}
+
+static __m128i absdiff8(const uint8_t *p, const uint8_t *q)
+{
+    __m128i a = _mm_loadl_epi64((const __m128i *)(const void *)p);
+    __m128i b = _mm_loadl_epi64((const __m128i *)(const void *)q);
+    return _mm_unpacklo_epi8(_mm_or_si128(_mm_subs_epu8(a, b), _mm_subs_epu8(b, a)), _mm_setzero_si128());
+}
+
+static void select_keys_sse(const uint8_t *row, ptrdiff_t stride, int w, int b, int dy,
+                            int16_t *keys, int accumulate)
+{
+    const __m128i iota = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7), mask = _mm_set1_epi16((short)(b - 1));
+    const __m128i base = _mm_set1_epi16((short)(dy * b));
+    int x;
+    if (!accumulate) keys[0] = keys[w - 1] = 0;
+    for (x = 1; x + 8 <= w - 1; x += 8) {
+        __m128i s = _mm_add_epi16(absdiff8(row + x + 1, row + x - 1),
+                                  absdiff8(row + x + stride, row + x - stride));
+        __m128i off = _mm_add_epi16(base, _mm_and_si128(_mm_add_epi16(_mm_set1_epi16((short)x), iota), mask));
+        __m128i key = _mm_or_si128(_mm_slli_epi16(s, 4), off);
+        __m128i *dst = (__m128i *)(void *)(keys + x);
+        if (accumulate) key = _mm_max_epi16(key, _mm_loadu_si128(dst));
+        _mm_storeu_si128(dst, key);
+    }
+    for (; x < w - 1; x++) {
+        int gx = row[x + 1] - row[x - 1], gy = row[x + stride] - row[x - stride];
+        int key = ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)) << 4 | (dy * b + (x & (b - 1)));
+        if (!accumulate || key > keys[x]) keys[x] = (int16_t)key;
+    }
+}
+
+static __m128 load4_s16(const int16_t *p)
+{
+    __m128i v = _mm_loadl_epi64((const __m128i *)(const void *)p);
+    return _mm_cvtepi32_ps(_mm_srai_epi32(_mm_unpacklo_epi16(v, v), 16));
+}
+
+static void warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n,
+                     const uint8_t *img, ptrdiff_t stride, int w, int h, float *out)
+{
+    const __m128 xmax = _mm_set1_ps((float)(w - 1)), ymax = _mm_set1_ps((float)(h - 1));
+    const __m128 zero = _mm_setzero_ps(), minus1 = _mm_set1_ps(-1.0f);
+    __m128 mm[9];
+    int i, k;
+    for (k = 0; k < 9; k++) mm[k] = _mm_set1_ps(m[k]);
+    for (i = 0; i < n; i += 4) {
+        __m128 x = load4_s16(xs + i), y = load4_s16(ys + i);
+        __m128 d = _mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[6], x), _mm_mul_ps(mm[7], y)), mm[8]);
+        __m128 px = _mm_div_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[0], x), _mm_mul_ps(mm[1], y)), mm[2]), d);
+        __m128 py = _mm_div_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[3], x), _mm_mul_ps(mm[4], y)), mm[5]), d);
+        __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpge_ps(px, zero)),
+                               _mm_and_ps(_mm_cmpge_ps(py, zero),
+                                          _mm_and_ps(_mm_cmplt_ps(px, xmax), _mm_cmplt_ps(py, ymax))));
+        __m128i ix, iy;
+        __m128 fx, fy, p00, p01, p10, p11, top, bot, val;
+        int32_t cx[4], cy[4];
+        float f00[4], f01[4], f10[4], f11[4];
+        px = _mm_and_ps(px, ok);          /* invalid lanes sample (0, 0): in bounds, discarded */
+        py = _mm_and_ps(py, ok);
+        ix = _mm_cvttps_epi32(px);
+        iy = _mm_cvttps_epi32(py);
+        fx = _mm_sub_ps(px, _mm_cvtepi32_ps(ix));
+        fy = _mm_sub_ps(py, _mm_cvtepi32_ps(iy));
+        _mm_storeu_si128((__m128i *)(void *)cx, ix);
+        _mm_storeu_si128((__m128i *)(void *)cy, iy);
+        for (k = 0; k < 4; k++) {
+            const uint8_t *p = img + (ptrdiff_t)cy[k] * stride + cx[k];
+            f00[k] = (float)p[0]; f01[k] = (float)p[1]; f10[k] = (float)p[stride]; f11[k] = (float)p[stride + 1];
+        }
+        p00 = _mm_loadu_ps(f00); p01 = _mm_loadu_ps(f01); p10 = _mm_loadu_ps(f10); p11 = _mm_loadu_ps(f11);
+        top = _mm_add_ps(p00, _mm_mul_ps(fx, _mm_sub_ps(p01, p00)));
+        bot = _mm_add_ps(p10, _mm_mul_ps(fx, _mm_sub_ps(p11, p10)));
+        val = _mm_add_ps(top, _mm_mul_ps(fy, _mm_sub_ps(bot, top)));
+        _mm_storeu_ps(out + i, _mm_or_ps(_mm_and_ps(ok, val), _mm_andnot_ps(ok, minus1)));
+    }
+}
+
+static void accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
+                           const int16_t *gys, const float *r, const float *w, int n,
+                           const float *aff, float *acc)
+{
+    const __m128 a = _mm_set1_ps(aff[0]), bu = _mm_set1_ps(aff[1]), bv = _mm_set1_ps(aff[2]);
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    __m128 sum[HOME__REFINE_ACC];
+    int i, p, q, k;
+    for (k = 0; k < HOME__REFINE_ACC; k++) sum[k] = _mm_setzero_ps();
+    for (i = 0; i < n; i += 4) {
+        __m128 u = _mm_add_ps(_mm_mul_ps(a, load4_s16(xs + i)), bu);
+        __m128 v = _mm_add_ps(_mm_mul_ps(a, load4_s16(ys + i)), bv);
+        __m128 gx = load4_s16(gxs + i), gy = load4_s16(gys + i);
+        __m128 g = _mm_add_ps(_mm_mul_ps(gx, u), _mm_mul_ps(gy, v));
+        __m128 wi = _mm_loadu_ps(w + i), wr = _mm_mul_ps(wi, _mm_loadu_ps(r + i));
+        __m128 sd[8];
+        sd[0] = _mm_mul_ps(gx, u); sd[1] = _mm_mul_ps(gx, v); sd[2] = gx;
+        sd[3] = _mm_mul_ps(gy, u); sd[4] = _mm_mul_ps(gy, v); sd[5] = gy;
+        sd[6] = _mm_xor_ps(_mm_mul_ps(u, g), sign); sd[7] = _mm_xor_ps(_mm_mul_ps(v, g), sign);
+        for (p = 0, k = 0; p < 8; p++) {
+            __m128 ws = _mm_mul_ps(wi, sd[p]);
+            for (q = p; q < 8; q++, k++) sum[k] = _mm_add_ps(sum[k], _mm_mul_ps(ws, sd[q]));
+            sum[36 + p] = _mm_add_ps(sum[36 + p], _mm_mul_ps(sd[p], wr));
+        }
+    }
+    for (k = 0; k < HOME__REFINE_ACC; k++) _mm_storeu_ps(acc + k * HOME__REFINE_LANES, sum[k]);
+}
+
+const home__refine_kernels home__refine_kernels_sse = {
+    "sse", blur3_sse, downsample_sse, select_keys_sse, warp_sse, accumulate_sse};
+#else
+typedef int home__refine_sse_unused; /* ISO C forbids an empty translation unit */
+#endif
