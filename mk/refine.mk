@@ -18,3 +18,19 @@ $(BUILD)/obj/bench/refine/%.o: bench/refine/%.c include/home.h $(wildcard exampl
 $(REFINE_PAIR): $(BUILD)/obj/bench/refine/refine-pair.o $(SUPPORT_OBJ) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+
+# port/refine_kernels.h is not in the generic object rules' prerequisites
+$(BUILD)/obj/src/refine.o $(BUILD)/obj/src/arena.o $(BUILD)/obj/src/pipeline.o $(BUILD)/obj/tests/test_refine.o: port/refine_kernels.h
+$(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/refine_*.c)): port/refine_kernels.h
+
+# make bench-refine: per-frame cost of the refinement (video case) next to HOME alone
+REFINE_BENCH := $(BUILD)/bin/home-bench-refine
+BINS += $(REFINE_BENCH)
+all: $(REFINE_BENCH)
+$(REFINE_BENCH): $(BUILD)/obj/bench/refine/bench_refine.o $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+.PHONY: bench-refine
+bench-refine: $(REFINE_BENCH)
+	$(RUNNER) $(REFINE_BENCH) --frames 40
+	$(RUNNER) $(REFINE_BENCH) --frames 40 --kind weak

@@ -1,4 +1,5 @@
-/* Dispatch of the refinement kernels: the same choice as home__kernels_for(). */
+/* Dispatch of the refinement kernels: the same choice as home__kernels_for(); AVX2 contexts
+ * use the SSE2 refinement kernels (the refinement has no AVX2 version). */
 #include "refine_kernels.h"
 #include "home.h"
 
@@ -7,6 +8,7 @@ const home__refine_kernels *home__refine_kernels_for(int simd)
     switch (simd) {
     case HOME_SIMD_NONE: return &home__refine_kernels_scalar;
     case HOME_SIMD_SSE:
+    case HOME_SIMD_AVX2:
 #if defined(__SSE2__)
         return &home__refine_kernels_sse;
 #else

@@ -4,6 +4,7 @@
 
 #include "home.h"
 #include "kernels.h"
+#include "refine_kernels.h"
 
 #define HOME__MAGIC_CTX 0x484f4d43u   /* "HOMC" */
 #define HOME__MAGIC_FEAT 0x484f4d46u  /* "HOMF" */
@@ -52,6 +53,7 @@ typedef struct home__refine_state {
     uint32_t pyr_id, slot_id[2];
     int next_slot;
     home__refine_points tpl[2][HOME_REFINE_MAX_LEVELS];
+    const home__refine_kernels *rk;   /* SIMD backend, as cfg.simd */
     void *scratch;
 } home__refine_state;
 
@@ -150,14 +152,5 @@ size_t home__refine_bytes(const home_config *cfg);
 void home__refine_init(home_context *ctx, unsigned char *block);
 uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride);
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result);
-void home__refine_blur3(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
-                        ptrdiff_t dst_stride, int w, int h);
-void home__refine_downsample(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
-                             ptrdiff_t dst_stride, int dst_w, int dst_h);
-void home__refine_warp(const float *m, const int16_t *xs, const int16_t *ys, int n,
-                       const uint8_t *img, ptrdiff_t stride, int w, int h, float *out);
-void home__refine_accumulate(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
-                             const int16_t *gys, const float *r, const float *w, int n,
-                             const float *aff, float *acc);
 
 #endif

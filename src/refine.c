@@ -24,8 +24,8 @@
 #include <math.h>
 #include <string.h>
 
-#define LANES 4
-#define N_ACC 44            /* 36 upper-triangle entries of J^T W J, then 8 of J^T W r */
+#define LANES HOME__REFINE_LANES
+#define N_ACC HOME__REFINE_ACC
 #define HIST_BINS 512       /* |residual| histogram, 1/8 grey level per bin */
 #define CAUCHY_K 2.385     /* 95 % efficiency at Gaussian noise */
 #define SIGMA_FLOOR 0.5     /* grey levels: the residual scale never collapses below this */
@@ -90,8 +90,8 @@ static size_t blocks_at(const home_config *cfg, int level)
     return ((w + b - 1) / b) * ((h + b - 1) / b);
 }
 
-/* Scratch: per-point floats at match time (two warps, residuals, weights), or the block
- * scores of the point selection at extraction time. */
+/* Scratch: per-point floats at match time (two warps, residuals, weights), or at extraction
+ * time a row of int16 for the blur and a row of selection keys, then the block cells. */
 static size_t scratch_bytes(const home_config *cfg)
 {
     size_t match = 4 * (size_t)level_capacity(0) * sizeof(float), sel = 0;
@@ -100,6 +100,7 @@ static size_t scratch_bytes(const home_config *cfg)
         size_t s = blocks_at(cfg, l) * sizeof(uint16_t);
         if (s > sel) sel = s;
     }
+    sel += align64((size_t)cfg->width * sizeof(int16_t));
     return match > sel ? match : sel;
 }
 
@@ -121,6 +122,8 @@ void home__refine_init(home_context *ctx, unsigned char *block)
     int l, s;
     memset(st, 0, sizeof *st);
     st->levels = ctx->cfg.refine_levels ? levels_for(&ctx->cfg) : 0;
+    st->rk = home__refine_kernels_for(ctx->cfg.simd);
+    if (!st->rk) st->rk = &home__refine_kernels_scalar; /* every backend gives the same result */
     for (l = 0; l < st->levels; l++) {
         st->w[l] = ctx->cfg.width >> l;
         st->h[l] = ctx->cfg.height >> l;
@@ -141,95 +144,6 @@ void home__refine_init(home_context *ctx, unsigned char *block)
 }
 
 /* ---------------------------------------------------------------------------------------------
- * Scalar reference kernels (SIMD backends reproduce them: integers exactly, floats lane by lane
- * in the same operation order) */
-
-/* 3x3 binomial blur ([1 2 1] / 4 both ways, rounded once), edges replicated. Sharp, aliased
- * edges would otherwise bias bilinear interpolation by hundredths of a pixel. */
-void home__refine_blur3(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
-                        ptrdiff_t dst_stride, int w, int h)
-{
-    int x, y;
-    for (y = 0; y < h; y++) {
-        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
-        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
-        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
-        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
-        for (x = 0; x < w; x++) {
-            int l = x > 0 ? x - 1 : 0, r = x < w - 1 ? x + 1 : w - 1;
-            int left = a[l] + 2 * b[l] + c[l], mid = a[x] + 2 * b[x] + c[x];
-            int right = a[r] + 2 * b[r] + c[r];
-            d[x] = (uint8_t)((left + 2 * mid + right + 8) >> 4);
-        }
-    }
-}
-
-/* 2x2 box average with rounding: dst is (src_w / 2) x (src_h / 2). */
-void home__refine_downsample(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
-                             ptrdiff_t dst_stride, int dst_w, int dst_h)
-{
-    int x, y;
-    for (y = 0; y < dst_h; y++) {
-        const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
-        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
-        for (x = 0; x < dst_w; x++)
-            d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
-    }
-}
-
-/* Bilinear samples of img at m * (x, y, 1) (perspective divide); -1 where the sample or its
- * 2x2 support leaves the image or the point maps behind the camera. */
-void home__refine_warp(const float *m, const int16_t *xs, const int16_t *ys, int n,
-                       const uint8_t *img, ptrdiff_t stride, int w, int h, float *out)
-{
-    const float xmax = (float)(w - 1), ymax = (float)(h - 1);
-    int i;
-    for (i = 0; i < n; i++) {
-        float x = (float)xs[i], y = (float)ys[i];
-        float d = m[6] * x + m[7] * y + m[8];
-        float px = (m[0] * x + m[1] * y + m[2]) / d;
-        float py = (m[3] * x + m[4] * y + m[5]) / d;
-        if (d > 0.0f && px >= 0.0f && py >= 0.0f && px < xmax && py < ymax) {
-            int ix = (int)px, iy = (int)py;
-            float fx = px - (float)ix, fy = py - (float)iy;
-            const uint8_t *p = img + (ptrdiff_t)iy * stride + ix;
-            float top = (float)p[0] + fx * (float)(p[1] - p[0]);
-            float bot = (float)p[stride] + fx * (float)(p[stride + 1] - p[stride]);
-            out[i] = top + fy * (bot - top);
-        } else {
-            out[i] = -1.0f;
-        }
-    }
-}
-
-/* Weighted normal equations of one IC step, per lane (point i feeds lane i % 4):
- * acc[k * 4 + lane], k < 36: upper triangle of sum w sd sd^T; k = 36 + j: sum w sd_j r, with
- * sd = (gx u, gx v, gx, gy u, gy v, gy, -u (gx u + gy v), -v (gx u + gy v)),
- * u = a x + bu, v = a y + bv. n is a multiple of 4. */
-void home__refine_accumulate(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
-                             const int16_t *gys, const float *r, const float *w, int n,
-                             const float *aff, float *acc)
-{
-    int i, p, q, k;
-    memset(acc, 0, N_ACC * LANES * sizeof *acc);
-    for (i = 0; i < n; i++) {
-        const int lane = i & (LANES - 1);
-        float u = aff[0] * (float)xs[i] + aff[1], v = aff[0] * (float)ys[i] + aff[2];
-        float gx = (float)gxs[i], gy = (float)gys[i];
-        float gr = gx * u + gy * v;
-        float sd[8], wr = w[i] * r[i];
-        sd[0] = gx * u; sd[1] = gx * v; sd[2] = gx;
-        sd[3] = gy * u; sd[4] = gy * v; sd[5] = gy;
-        sd[6] = -(u * gr); sd[7] = -(v * gr);
-        for (p = 0, k = 0; p < 8; p++) {
-            float ws = w[i] * sd[p];
-            for (q = p; q < 8; q++, k++) acc[k * LANES + lane] += ws * sd[q];
-            acc[(36 + p) * LANES + lane] += sd[p] * wr;
-        }
-    }
-}
-
-/* ---------------------------------------------------------------------------------------------
  * Per-frame snapshot: pyramid and template points */
 
 static uint32_t hash_bytes(const uint8_t *p, size_t n)
@@ -247,33 +161,30 @@ static uint32_t hash_bytes(const uint8_t *p, size_t n)
 }
 
 /* Pick the strongest-gradient pixel of every block, keep those above the level's floor,
- * strongest first (score bins, then scan order) up to the capacity. */
-static void select_points(const uint8_t *img, int w, int h, int level, uint16_t *cells,
-                          home__refine_points *out)
+ * strongest first (score bins, then scan order) up to the capacity. keys: w int16; cells: one
+ * uint16 per block (bit 15 set: a candidate, score bin << 4 | offset in the block). */
+static void select_points(const home__refine_kernels *rk, const uint8_t *img, int w, int h,
+                          int level, int16_t *keys, uint16_t *cells, home__refine_points *out)
 {
     const int b = block_side(level), floor_score = score_floor(level);
     const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
-    int hist[256], bx, by, x, y, bin, quota, n = 0, cut, above;
+    int hist[256], bx, by, x, y, dy, bin, quota, n = 0, cut, above;
     memset(hist, 0, sizeof hist);
     for (by = 0; by < bh; by++) {
+        int rows = 0;
+        for (dy = 0; dy < b; dy++) {
+            y = by * b + dy;
+            if (y < 1 || y > h - 2) continue;
+            rk->select_keys(img + (ptrdiff_t)y * w, w, w, b, dy, keys, rows++ > 0);
+        }
         for (bx = 0; bx < bw; bx++) {
-            int best = -1, best_off = 0;
-            for (y = by * b; y < by * b + b && y < h - 1; y++) {
-                const uint8_t *row = img + (ptrdiff_t)y * w;
-                if (y < 1) continue;
-                for (x = bx * b; x < bx * b + b && x < w - 1; x++) {
-                    int gx, gy, s;
-                    if (x < 1) continue;
-                    gx = row[x + 1] - row[x - 1];
-                    gy = row[x + w] - row[x - w];
-                    s = (gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy);
-                    if (s > best) best = s, best_off = (y - by * b) * b + (x - bx * b);
-                }
-            }
-            if (best >= floor_score) {
-                bin = best >> 2 > 255 ? 255 : best >> 2;
+            int best = 0;
+            if (rows)
+                for (x = bx * b; x < bx * b + b && x < w; x++) best = keys[x] > best ? keys[x] : best;
+            if ((best >> 4) >= floor_score) {
+                bin = (best >> 6) > 255 ? 255 : best >> 6;
                 hist[bin]++;
-                cells[by * bw + bx] = (uint16_t)(bin << 4 | best_off) | 0x8000u;
+                cells[by * bw + bx] = (uint16_t)(0x8000 | bin << 4 | (best & 15));
             } else {
                 cells[by * bw + bx] = 0;
             }
@@ -314,10 +225,13 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
 {
     home__refine_state *st = &ctx->refine;
     int l, slot;
+    int16_t *row_tmp = (int16_t *)st->scratch;
+    uint16_t *cells = (uint16_t *)(void *)((unsigned char *)st->scratch +
+                                           align64((size_t)st->w[0] * sizeof(int16_t)));
     if (!st->levels) return 0;
-    home__refine_blur3(image, stride, st->pyr[0], st->w[0], st->w[0], st->h[0]);
+    st->rk->blur3(image, stride, st->pyr[0], st->w[0], st->w[0], st->h[0], row_tmp);
     for (l = 1; l < st->levels; l++)
-        home__refine_downsample(st->pyr[l - 1], st->w[l - 1], st->pyr[l], st->w[l], st->w[l], st->h[l]);
+        st->rk->downsample(st->pyr[l - 1], st->w[l - 1], st->pyr[l], st->w[l], st->w[l], st->h[l]);
     /* the id is a hash of the data: the same frame gets the same id, so outputs stay
      * deterministic, and features are tied to the snapshot they were extracted with */
     l = st->levels > 1 ? 1 : 0;
@@ -325,7 +239,7 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     slot = st->next_slot;
     st->next_slot ^= 1;
     for (l = 0; l < st->levels; l++)
-        select_points(st->pyr[l], st->w[l], st->h[l], l, (uint16_t *)st->scratch, &st->tpl[slot][l]);
+        select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
     st->slot_id[slot] = st->pyr_id;
     return st->pyr_id;
 }
@@ -518,7 +432,7 @@ static int iterate(solver *s, int level, double *step_px)
     int i, j, p, q, valid;
 
     level_matrix(s, s->hn, level, m);
-    home__refine_warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
                       st->h[level], s->img_b);
     s->sigma = robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta);
     valid = fit_photometric(s, tp, s->img_b, NULL, s->sigma, s->res, s->wt);
@@ -526,7 +440,7 @@ static int iterate(solver *s, int level, double *step_px)
     aff[0] = (float)(sc / s->f);
     aff[1] = (float)((o - s->cx) / s->f);
     aff[2] = (float)((o - s->cy) / s->f);
-    home__refine_accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff, acc);
+    st->rk->accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff, acc);
     for (p = 0, j = 0; p < 8; p++) {
         for (q = p; q < 8; q++, j++) {
             const float *l = acc + j * LANES;
@@ -599,7 +513,7 @@ static double photometric_error(solver *s, const double *hn, const float *other_
     float m[9];
     int i, it, n = 0;
     level_matrix(s, hn, 0, m);
-    home__refine_warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], img_b);
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], img_b);
     s->alpha = 1.0;
     s->beta = 0.0;
     for (it = 0; it < 3; it++) fit_photometric(s, tp, img_b, other_b, sigma, s->res, s->wt);
@@ -690,10 +604,10 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
         const home__refine_points *tp = &s.tpl[0];
         float m[9];
         level_matrix(&s, s.hn, 0, m);
-        home__refine_warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
+        st->rk->warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
                           st->w[0], st->w[0], st->h[0], s.img_b2);
         level_matrix(&s, hn0, 0, m);
-        home__refine_warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
+        st->rk->warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
                           st->w[0], st->w[0], st->h[0], s.img_b);
         s.alpha = 1.0;
         s.beta = 0.0;
@@ -701,7 +615,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
         sigma0 = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta);
         e0 = photometric_error(&s, hn0, s.img_b2, sigma0, s.img_b, &zncc0);
         level_matrix(&s, hn0, 0, m);
-        home__refine_warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
+        st->rk->warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
                           st->w[0], st->w[0], st->h[0], s.img_b2);
         e1 = photometric_error(&s, s.hn, s.img_b2, sigma0, s.img_b, &zncc1);
     }

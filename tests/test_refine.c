@@ -338,8 +338,9 @@ void test_failure_rule_rescue(void)
 
 void test_kernels_match_references(void)
 {
-    /* downsample: rounded 2x2 mean; warp: bilinear at exact integer shifts; accumulate: the
-     * double-precision normal equations */
+    /* the scalar reference against plain definitions: downsample = rounded 2x2 mean; warp =
+     * the pixel itself at integer shifts; accumulate = the double-precision normal equations */
+    const home__refine_kernels *k = home__refine_kernels_for(HOME_SIMD_NONE);
     static uint8_t src[37 * 23], dst[18 * 11];
     static int16_t xs[64], ys[64], gx[64], gy[64];
     static float r[64], w[64], out[64], acc[44 * 4];
@@ -349,7 +350,7 @@ void test_kernels_match_references(void)
     double ref[44];
     synth_seed(&rng, 77);
     for (i = 0; i < (int)sizeof src; i++) src[i] = (uint8_t)(synth_uniform(&rng) * 256);
-    home__refine_downsample(src, 37, dst, 18, 18, 11);
+    k->downsample(src, 37, dst, 18, 18, 11);
     for (y = 0; y < 11; y++)
         for (x = 0; x < 18; x++) {
             int s = src[2 * y * 37 + 2 * x] + src[2 * y * 37 + 2 * x + 1] +
@@ -365,24 +366,23 @@ void test_kernels_match_references(void)
         r[i] = (float)(synth_uniform(&rng) * 20 - 10);
         w[i] = (float)synth_uniform(&rng);
     }
-    home__refine_warp(m, xs, ys, 64, src, 37, 37, 23, out);
+    k->warp(m, xs, ys, 64, src, 37, 37, 23, out);
     for (i = 0, bad = 0; i < 64; i++) {
         int px = xs[i] + 2, py = ys[i] + 3;
         float expect = (px >= 0 && py >= 0 && px < 36 && py < 22) ? (float)src[py * 37 + px] : -1.0f;
         bad += out[i] != expect;
     }
     CHECK_EQ_INT(bad, 0);
-    home__refine_accumulate(xs, ys, gx, gy, r, w, 64, aff, acc);
+    k->accumulate(xs, ys, gx, gy, r, w, 64, aff, acc);
     memset(ref, 0, sizeof ref);
     for (i = 0; i < 64; i++) {
         double u = aff[0] * (double)xs[i] + aff[1], v = aff[0] * (double)ys[i] + aff[2], g = gx[i] * u + gy[i] * v;
         double sd[8];
-        int k = 0;
+        int q, c = 0;
         sd[0] = gx[i] * u; sd[1] = gx[i] * v; sd[2] = gx[i]; sd[3] = gy[i] * u; sd[4] = gy[i] * v;
         sd[5] = gy[i]; sd[6] = -u * g; sd[7] = -v * g;
         for (j = 0; j < 8; j++) {
-            int q;
-            for (q = j; q < 8; q++) ref[k++] += w[i] * sd[j] * sd[q];
+            for (q = j; q < 8; q++) ref[c++] += w[i] * sd[j] * sd[q];
             ref[36 + j] += w[i] * sd[j] * r[i];
         }
     }
@@ -391,6 +391,64 @@ void test_kernels_match_references(void)
         bad += fabs(s - ref[j]) > 1e-4 * (fabs(ref[j]) + 1.0);
     }
     CHECK_EQ_INT(bad, 0);
+}
+
+/* Every compiled-in backend reproduces the scalar kernels bit for bit: odd sizes, unaligned
+ * pointers, points leaving the image, extreme grey levels. */
+void test_kernels_backends_identical(void)
+{
+    static const int simds[2] = {HOME_SIMD_SSE, HOME_SIMD_NEON};
+    const home__refine_kernels *ref = home__refine_kernels_for(HOME_SIMD_NONE);
+    static uint8_t src[101 * 67 + 64], d_ref[101 * 67], d_simd[101 * 67];
+    static int16_t t_ref[128], t_simd[128], k_ref[128], k_simd[128];
+    static int16_t xs[260], ys[260], gx[260], gy[260];
+    static float r[260], w[260], o_ref[260], o_simd[260], a_ref[44 * 4], a_simd[44 * 4];
+    const float aff[3] = {0.0123f, -0.71f, -0.4f};
+    float m[9];
+    synth_rng rng;
+    int s, i, off, tested = 0;
+    synth_seed(&rng, 99);
+    for (i = 0; i < (int)sizeof src; i++)
+        src[i] = (uint8_t)(i % 7 == 0 ? 255 * (i % 2) : synth_uniform(&rng) * 256);
+    for (i = 0; i < 260; i++) {
+        xs[i] = (int16_t)(synth_uniform(&rng) * 110 - 5);
+        ys[i] = (int16_t)(synth_uniform(&rng) * 75 - 4);
+        gx[i] = (int16_t)(synth_uniform(&rng) * 1020 - 510);
+        gy[i] = (int16_t)(synth_uniform(&rng) * 1020 - 510);
+        r[i] = (float)(synth_gauss(&rng) * 30);
+        w[i] = (float)synth_uniform(&rng);
+    }
+    m[0] = 1.01f; m[1] = 0.02f; m[2] = 0.7f; m[3] = -0.015f; m[4] = 0.99f; m[5] = -1.3f;
+    m[6] = 1e-4f; m[7] = -2e-4f; m[8] = 1.0f;
+    for (s = 0; s < 2; s++) {
+        const home__refine_kernels *k = home__refine_kernels_for(simds[s]);
+        if (!k) continue;
+        tested++;
+        for (off = 0; off < 3; off++) {
+            const uint8_t *in = src + off;
+            int width = 101 - 2 * off, height = 67 - off, b, dy;
+            ref->blur3(in, 101, d_ref, 101, width, height, t_ref);
+            k->blur3(in, 101, d_simd, 101, width, height, t_simd);
+            CHECK(memcmp(d_ref, d_simd, sizeof d_ref) == 0);
+            ref->downsample(in, 101, d_ref, 50, width / 2, height / 2);
+            k->downsample(in, 101, d_simd, 50, width / 2, height / 2);
+            CHECK(memcmp(d_ref, d_simd, sizeof d_ref) == 0);
+            for (b = 1; b <= 4; b *= 2)
+                for (dy = 0; dy < b; dy++) {
+                    ref->select_keys(in + 101 * (dy + 1), 101, width, b, dy, k_ref, dy > 0);
+                    k->select_keys(in + 101 * (dy + 1), 101, width, b, dy, k_simd, dy > 0);
+                    CHECK(memcmp(k_ref, k_simd, (size_t)width * sizeof *k_ref) == 0);
+                }
+            ref->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_ref);
+            k->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_simd);
+            CHECK(memcmp(o_ref, o_simd, 256 * sizeof *o_ref) == 0);
+            ref->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, a_ref);
+            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, a_simd);
+            CHECK(memcmp(a_ref, a_simd, sizeof a_ref) == 0);
+        }
+        printf("     %s: identical to scalar\n", k->name);
+    }
+    if (!tested) printf("     no SIMD backend compiled in\n");
 }
 
 void test_arena_and_config(void)
@@ -435,7 +493,7 @@ void test_refine_bad_inputs(void)
 }
 
 #define TEST_LIST(X) \
-    X(kernels_match_references) X(arena_and_config) X(textured_subpixel) X(lines_subpixel) \
+    X(kernels_match_references) X(kernels_backends_identical) X(arena_and_config) X(textured_subpixel) X(lines_subpixel) \
     X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
