@@ -1,0 +1,248 @@
+/* home-stab: offline stabilisation of a Y4M stream (4:2:0, 4:2:2 or mono) with libhome.
+ *   ffmpeg -i in.mp4 -f yuv4mpegpipe - | home-stab - - | ffmpeg -i - out.mp4
+ * The output has the input's size: the crop window is scaled to fill the frame. */
+#define _POSIX_C_SOURCE 200809L
+#include "home_stab.h"
+#include "stab_png.h"
+#include "y4m.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now_ms(void *user)
+{
+    struct timespec ts;
+    (void)user;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: home-stab [options] IN.y4m OUT.y4m      (- for stdin / stdout)\n"
+            "  --margin F        crop margin per side, fraction of the frame (default 0.10)\n"
+            "  --smoothing F     path smoothing time constant, frames (default 15)\n"
+            "  --lookahead N     frames of latency for fixed-lag smoothing (default 0)\n"
+            "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 480 px)\n"
+            "  --keypoints N     HOME keypoints per sign (default 500)\n"
+            "  --side-by-side    write original | stabilised, twice as wide\n"
+            "  --csv FILE        per-frame raw and smoothed camera path\n"
+            "  --plot FILE.png   plot of the raw and smoothed path\n"
+            "  --quiet           no progress on stderr\n"
+            "Exit: 0 ok; 1 input ended with a malformed or truncated frame (the frames before it\n"
+            "are written); 2 bad usage or unreadable input.\n");
+}
+
+static int number(const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    double v = strtod(s, &end);
+    if (*end || end == s || !(v >= lo && v <= hi)) return -1;
+    *out = v;
+    return 0;
+}
+
+typedef struct app {
+    y4m_info info;
+    FILE *out, *csv;
+    int side_by_side, quiet;
+    size_t frame_bytes;
+    uint8_t **ring;               /* lookahead + 1 input frames */
+    int ring_len;
+    uint8_t *result, *wide;
+    int *inliers;                 /* per ring slot: the frame's registration inliers */
+    stab_path_plot plot;
+    long written;
+} app;
+
+static const char *status_name(int s)
+{
+    static const char *names[] = {"first", "ok", "failed", "implausible"};
+    return s >= 0 && s < 4 ? names[s] : "?";
+}
+
+/* Copy the planes of a (w x h) frame into the left or right half of a 2w-wide frame. */
+static void place(const y4m_info *info, const uint8_t *src, uint8_t *wide, int right)
+{
+    home_stab_image a, b;
+    int k, row, rows, bytes;
+    y4m_image(info, info->width, (uint8_t *)src, &a);
+    y4m_image(info, 2 * info->width, wide, &b);
+    for (k = 0; k < 3 && a.plane[k]; k++) {
+        rows = k && info->chroma == 420 ? info->height / 2 : info->height;
+        bytes = (int)a.stride[k];
+        for (row = 0; row < rows; row++)
+            memcpy(b.plane[k] + row * b.stride[k] + (right ? bytes : 0), a.plane[k] + row * a.stride[k], (size_t)bytes);
+    }
+}
+
+static int write_output(app *ap, const home_stab_output *o)
+{
+    const uint8_t *src = ap->ring[o->frame % ap->ring_len];
+    home_stab_image in, out;
+    int status;
+    y4m_image(&ap->info, ap->info.width, (uint8_t *)src, &in);
+    y4m_image(&ap->info, ap->info.width, ap->result, &out);
+    status = home_stab_warp(o->warp, &in, &out);
+    if (status != HOME_OK) {
+        fprintf(stderr, "home-stab: warp: %s\n", home_strerror(status));
+        return -1;
+    }
+    if (ap->side_by_side) {
+        place(&ap->info, src, ap->wide, 0);
+        place(&ap->info, ap->result, ap->wide, 1);
+    }
+    if (y4m_write_frame(ap->out, ap->side_by_side ? ap->wide : ap->result,
+                        ap->side_by_side ? 2 * ap->frame_bytes : ap->frame_bytes)) {
+        fprintf(stderr, "home-stab: write error\n");
+        return -1;
+    }
+    if (ap->csv)
+        fprintf(ap->csv, "%ld,%s,%d,%.4f,%.4f,%.6f,%.6f,%.4f,%.4f,%.6f,%.6f,%.4f\n", o->frame,
+                status_name(o->motion_status), ap->inliers[o->frame % ap->ring_len], o->raw.tx,
+                o->raw.ty, o->raw.angle, o->raw.log_scale, o->smooth.tx, o->smooth.ty,
+                o->smooth.angle, o->smooth.log_scale, o->correction_used);
+    stab_plot_add(&ap->plot, &o->raw, &o->smooth);
+    ap->written++;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
+    home_stab_config cfg;
+    double margin = 0.10, smoothing = 15, lookahead = 0, downscale = 0, keypoints = 500;
+    double t_start, ms_reg = 0, ms_warp = 0, last_report;
+    app ap;
+    home_stab *stab = NULL;
+    home_stab_output o;
+    void *arena = NULL;
+    FILE *in;
+    char err[256];
+    int i, status, rc = 0, got;
+    long frames = 0, failed = 0;
+    size_t need;
+
+    memset(&ap, 0, sizeof ap);
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        double *target = NULL, lo = 0, hi = 0;
+        if (!strcmp(a, "--help")) { usage(stdout); return 0; }
+        if (!strcmp(a, "--side-by-side")) { ap.side_by_side = 1; continue; }
+        if (!strcmp(a, "--quiet")) { ap.quiet = 1; continue; }
+        if (!strcmp(a, "-") || a[0] != '-') {
+            if (!in_path) in_path = a;
+            else if (!out_path) out_path = a;
+            else { fprintf(stderr, "home-stab: too many arguments\n"); return 2; }
+            continue;
+        }
+        if (i + 1 >= argc) { fprintf(stderr, "home-stab: %s needs a value\n", a); return 2; }
+        if (!strcmp(a, "--csv")) { csv_path = argv[++i]; continue; }
+        if (!strcmp(a, "--plot")) { plot_path = argv[++i]; continue; }
+        if (!strcmp(a, "--margin")) { target = &margin; lo = 0; hi = 0.4; }
+        else if (!strcmp(a, "--smoothing")) { target = &smoothing; lo = 1; hi = 1000; }
+        else if (!strcmp(a, "--lookahead")) { target = &lookahead; lo = 0; hi = HOME_STAB_MAX_LOOKAHEAD; }
+        else if (!strcmp(a, "--downscale")) { target = &downscale; lo = 1; hi = 4; }
+        else if (!strcmp(a, "--keypoints")) { target = &keypoints; lo = 16; hi = HOME_MAX_KEYPOINTS_PER_SIGN; }
+        else { fprintf(stderr, "home-stab: unknown option %s (see --help)\n", a); return 2; }
+        if (number(argv[++i], lo, hi, target)) {
+            fprintf(stderr, "home-stab: bad value for %s: %s (%g..%g)\n", a, argv[i], lo, hi);
+            return 2;
+        }
+    }
+    if (!in_path || !out_path) { usage(stderr); return 2; }
+    in = strcmp(in_path, "-") ? fopen(in_path, "rb") : stdin;
+    if (!in) { fprintf(stderr, "home-stab: cannot open %s\n", in_path); return 2; }
+    if (y4m_read_header(in, &ap.info, err, sizeof err)) {
+        fprintf(stderr, "home-stab: %s: %s\n", in_path, err);
+        return 2;
+    }
+    status = home_stab_default_config(&cfg, ap.info.width, ap.info.height);
+    cfg.margin = (float)margin;
+    cfg.smoothing = (float)smoothing;
+    cfg.lookahead = (int)lookahead;
+    if (downscale > 0) cfg.downscale = (int)downscale;
+    cfg.keypoints_per_sign = (int)keypoints;
+    cfg.clock = now_ms;
+    if (status == HOME_OK) status = home_stab_validate_config(&cfg);
+    if (status != HOME_OK) {
+        fprintf(stderr, "home-stab: %dx%d: %s\n", ap.info.width, ap.info.height, home_strerror(status));
+        return 2;
+    }
+    need = home_stab_arena_size(&cfg);
+    if (posix_memalign(&arena, HOME_ARENA_ALIGN, need)) arena = NULL;
+    ap.frame_bytes = y4m_frame_bytes(&ap.info);
+    ap.ring_len = cfg.lookahead + 1;
+    ap.ring = calloc((size_t)ap.ring_len, sizeof *ap.ring);
+    ap.inliers = calloc((size_t)ap.ring_len, sizeof *ap.inliers);
+    ap.result = malloc(ap.frame_bytes);
+    ap.wide = malloc(2 * ap.frame_bytes);
+    if (!arena || !ap.ring || !ap.inliers || !ap.result || !ap.wide) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
+    for (i = 0; i < ap.ring_len; i++)
+        if (!(ap.ring[i] = malloc(ap.frame_bytes))) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
+    status = home_stab_init(&stab, &cfg, arena, need, NULL);
+    if (status != HOME_OK) { fprintf(stderr, "home-stab: %s\n", home_strerror(status)); return 2; }
+    stab_plot_init(&ap.plot);
+
+    ap.out = strcmp(out_path, "-") ? fopen(out_path, "wb") : stdout;
+    if (!ap.out) { fprintf(stderr, "home-stab: cannot write %s\n", out_path); return 2; }
+    if (csv_path) {
+        if (!(ap.csv = fopen(csv_path, "w"))) { fprintf(stderr, "home-stab: cannot write %s\n", csv_path); return 2; }
+        fprintf(ap.csv, "frame,status,inliers,raw_tx,raw_ty,raw_angle,raw_log_scale,smooth_tx,"
+                        "smooth_ty,smooth_angle,smooth_log_scale,correction_used\n");
+    }
+    y4m_write_header(ap.out, &ap.info, ap.side_by_side ? 2 * ap.info.width : ap.info.width);
+
+    t_start = last_report = now_ms(NULL);
+    for (;;) {
+        uint8_t *buf = ap.ring[frames % ap.ring_len];
+        home_stab_image im;
+        double t0;
+        got = y4m_read_frame(in, &ap.info, buf, err, sizeof err);
+        if (got == 0) break;
+        if (got < 0) {
+            fprintf(stderr, "home-stab: %s: frame %ld: %s; writing the %ld frames decoded so far\n",
+                    in_path, frames, err, frames);
+            rc = 1;
+            break;
+        }
+        y4m_image(&ap.info, ap.info.width, buf, &im);
+        status = home_stab_push(stab, &im, &o);
+        if (status != HOME_OK) { fprintf(stderr, "home-stab: %s\n", home_strerror(status)); rc = 2; break; }
+        ap.inliers[frames % ap.ring_len] = o.reg.inliers;
+        failed += o.newest_status == HOME_STAB_MOTION_FAILED || o.newest_status == HOME_STAB_MOTION_IMPLAUSIBLE;
+        ms_reg += o.ms_register;
+        frames++;
+        t0 = now_ms(NULL);
+        if (o.ready && write_output(&ap, &o)) { rc = 2; break; }
+        ms_warp += now_ms(NULL) - t0;
+        if (!ap.quiet && now_ms(NULL) - last_report >= 1000.0) {
+            last_report = now_ms(NULL);
+            fprintf(stderr, "home-stab: frame %ld, %.1f fps, register %.1f ms, warp %.1f ms, %ld held\n",
+                    frames, frames * 1e3 / (last_report - t_start), ms_reg / frames,
+                    ms_warp / frames, failed);
+        }
+    }
+    while (rc != 2 && home_stab_flush(stab, &o) == HOME_OK && o.ready)
+        if (write_output(&ap, &o)) { rc = 2; break; }
+    if (fflush(ap.out) != 0) { fprintf(stderr, "home-stab: write error\n"); rc = 2; }
+    if (!ap.quiet)
+        fprintf(stderr, "home-stab: %ld frames in, %ld out, %.1f fps, register %.1f ms/frame, "
+                        "warp %.1f ms/frame, %ld held (registration failed or implausible)\n",
+                frames, ap.written, frames * 1e3 / (now_ms(NULL) - t_start + 1e-9),
+                frames ? ms_reg / frames : 0.0, frames ? ms_warp / frames : 0.0, failed);
+    if (plot_path && stab_plot_write(&ap.plot, plot_path, ap.info.width, ap.info.height)) {
+        fprintf(stderr, "home-stab: cannot write %s\n", plot_path);
+        rc = 2;
+    }
+    if (ap.csv) fclose(ap.csv);
+    if (ap.out != stdout) fclose(ap.out);
+    if (in != stdin) fclose(in);
+    for (i = 0; i < ap.ring_len; i++) free(ap.ring[i]);
+    free(ap.ring); free(ap.inliers); free(ap.result); free(ap.wide); free(arena);
+    stab_plot_free(&ap.plot);
+    return rc;
+}

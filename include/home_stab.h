@@ -1,0 +1,138 @@
+/* libhome live electronic image stabilisation (home_stab_*).
+ *
+ * Per frame the stabiliser registers the frame's (optionally downscaled) luma to the previous
+ * frame with HOME, reusing the previous frame's features; fits a similarity (translation,
+ * rotation, zoom about the image centre) to HOME's homography; accumulates the camera path;
+ * smooths it with a constant-velocity Kalman filter and, with a lookahead of N frames, a
+ * fixed-lag Rauch-Tung-Striebel smoother over those N frames; and returns the warp that shows
+ * the smoothed camera through a crop window (margin m on each side, scaled to fill the frame).
+ * The correction is shrunk towards identity whenever the window would leave the frame, so the
+ * output never shows pixels from outside the input. A failed or implausible registration is
+ * taken as "no motion": the path holds and the correction decays smoothly towards identity.
+ *
+ * Frames, latency and memory: the caller owns every frame buffer. home_stab_push() takes the
+ * newest frame (only its luma is read) and, once N = lookahead frames are queued behind it,
+ * reports the warp for the frame pushed N calls earlier; the caller keeps its last N + 1 frames
+ * (a ring) and warps the reported one with home_stab_warp() into its output buffer. At the end
+ * of a stream home_stab_flush() reports the N frames still queued. Everything else - the HOME
+ * context, the two feature slots (previous/current, swapped by pointer), the downscaled luma,
+ * the path history - lives in one caller arena of home_stab_arena_size() bytes.
+ *
+ * Coordinates as in home.h: pixel centres, (0, 0) top-left. A warp maps output pixel
+ * coordinates to input (source) pixel coordinates of the luma plane; chroma follows with
+ * centre-sited subsampling. Threading: one thread per stabiliser at a time.
+ */
+#ifndef HOME_STAB_H
+#define HOME_STAB_H
+
+#include "home.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Largest lookahead (frames of latency) a stabiliser accepts. */
+#ifndef HOME_STAB_MAX_LOOKAHEAD
+#define HOME_STAB_MAX_LOOKAHEAD 120
+#endif
+
+/* Pixel formats of home_stab_image. */
+enum home_stab_format {
+    HOME_STAB_I420 = 1, /* planes Y, U, V; chroma w/2 x h/2 */
+    HOME_STAB_NV12,     /* planes Y, UV interleaved; chroma w/2 x h/2 */
+    HOME_STAB_YUYV,     /* one packed plane Y0 U Y1 V, 4:2:2 */
+    HOME_STAB_I422,     /* planes Y, U, V; chroma w/2 x h */
+    HOME_STAB_GREY      /* luma only */
+};
+
+typedef struct home_stab_image {
+    int format;               /* enum home_stab_format */
+    int width, height;        /* luma size; even for the subsampled formats */
+    uint8_t *plane[3];
+    ptrdiff_t stride[3];      /* bytes between rows of each plane */
+} home_stab_image;
+
+typedef struct home_stab_config {
+    int width, height;        /* frame size (luma) */
+    float margin;             /* crop margin on each side, fraction of the side; 0.10 */
+    float smoothing;          /* path smoothing time constant in frames (Kalman bandwidth
+                                 1/smoothing per frame); larger = steadier, more crop used */
+    int lookahead;            /* frames of latency used for fixed-lag smoothing; 0 = causal */
+    int downscale;            /* register on luma box-averaged by 1, 2 or 4 */
+    int keypoints_per_sign;   /* HOME's budget per frame (see home_config) */
+    int min_inliers;          /* HOME's failure rule (see home_config) */
+    float max_shift;          /* plausible per-frame translation, fraction of the width */
+    float max_rotation;       /* plausible per-frame rotation, radians */
+    float max_zoom;           /* plausible per-frame |log scale| */
+    float max_residual;       /* plausible RMS px gap between HOME's H and its similarity fit */
+    home_clock_fn clock;      /* optional: timings in home_stab_output */
+    void *clock_user;
+} home_stab_config;
+
+/* What became of a frame's registration to its predecessor. */
+enum home_stab_motion_status {
+    HOME_STAB_MOTION_FIRST = 0, /* first frame: nothing to register to */
+    HOME_STAB_MOTION_OK,        /* HOME's H, fitted by a similarity, is the motion */
+    HOME_STAB_MOTION_FAILED,    /* HOME found no trustworthy H: held (no motion) */
+    HOME_STAB_MOTION_IMPLAUSIBLE /* H outside the configured limits: held (no motion) */
+};
+
+/* A similarity about the image centre c: p -> exp(log_scale) R(angle) (p - c) + c + (tx, ty). */
+typedef struct home_stab_sim {
+    double tx, ty, angle, log_scale;
+} home_stab_sim;
+
+typedef struct home_stab_output {
+    int ready;                /* 1: warp frame `frame` now (0: nothing due yet / drained) */
+    long frame;               /* index (from 0, in push order) of the frame to warp */
+    double warp[9];           /* output pixel -> input pixel of that frame (affine, row-major) */
+    home_stab_sim raw;        /* camera path of that frame: frame 0 -> frame */
+    home_stab_sim smooth;     /* smoothed path of that frame */
+    double correction_used;   /* share of the smoothing correction applied: 1, or less where the
+                                 crop window had to stay inside the frame */
+    int motion_status;        /* enum home_stab_motion_status of that frame */
+    /* about the newest pushed frame: */
+    home_result reg;          /* its registration to the previous frame */
+    int newest_status;        /* enum home_stab_motion_status */
+    double ms_register;       /* downscale + extract + match (0 without a clock) */
+} home_stab_output;
+
+typedef struct home_stab home_stab;
+
+/* Defaults for a width x height stream: margin 0.10, smoothing 15, lookahead 0, downscale 2
+ * for frames wider than 480 px (else 1), 500 keypoints per sign. */
+int home_stab_default_config(home_stab_config *cfg, int width, int height);
+
+/* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */
+int home_stab_validate_config(const home_stab_config *cfg);
+
+/* Exact bytes home_stab_init() needs; 0 when cfg is invalid. */
+size_t home_stab_arena_size(const home_stab_config *cfg);
+
+/* Lay a stabiliser out in arena (aligned to HOME_ARENA_ALIGN). On HOME_E_ARENA_SMALL, *needed
+ * (if not NULL) receives the size required. */
+int home_stab_init(home_stab **stab, const home_stab_config *cfg, void *arena,
+                   size_t arena_bytes, size_t *needed);
+
+/* Push the newest frame (its luma only is read, during the call). out->ready says whether a
+ * frame is due: with lookahead N, the frame pushed N calls earlier. */
+int home_stab_push(home_stab *stab, const home_stab_image *frame, home_stab_output *out);
+
+/* End of stream: report the next queued frame (out->ready = 0 once none is left). */
+int home_stab_flush(home_stab *stab, home_stab_output *out);
+
+/* Forget the path and queued frames (e.g. after a scene cut or capture restart). */
+int home_stab_reset(home_stab *stab);
+
+/* Warp src into dst (same format and size) by the affine map warp (output luma pixel -> source
+ * luma pixel), bilinear in fixed point, edges replicated. HOME_E_CONFIG when the map is not
+ * affine or sends the frame further than one frame size outside the source. */
+int home_stab_warp(const double *warp, const home_stab_image *src, home_stab_image *dst);
+
+/* Similarity parameters <-> 3x3 matrices (about the centre of a width x height frame). */
+void home_stab_sim_to_matrix(const home_stab_sim *s, int width, int height, double *m);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,24 @@
+/* Private: the warp row kernel shared by src/warp.c and its SIMD versions (port/, later). */
+#ifndef HOME_STAB_WARP_H
+#define HOME_STAB_WARP_H
+#include <stddef.h>
+#include <stdint.h>
+
+/* Fixed point of warp coordinates: Q16 pixels; bilinear weights use the top 8 fraction bits. */
+#define HOME__WARP_FRAC_BITS 16
+
+/* One output row of a bilinear warp. Output pixel i samples the source at
+ * (x0 + i*dx, y0 + i*dy) (Q16 source pixels), clamped to [0, w-1] x [0, h-1] (edge replicate).
+ * Source pixel (x, y) is the byte src[y*stride + x*step]; output pixel i goes to dst[i*dst_step].
+ * Requires w, h >= 2 and every coordinate of the row within int32. With the fractions rounded to
+ * 1/256 (fx, fy in 0..256), the result is
+ * ((p00 (256-fx) + p01 fx) (256-fy) + (p10 (256-fx) + p11 fx) fy + 2^15) >> 16, and every
+ * implementation must give it bit for bit. */
+void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
+                      int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n);
+
+/* HOME_OK when im is a usable frame: known format, size within HOME's limits (even where
+ * chroma is subsampled), planes present, strides at least a row. */
+struct home_stab_image;
+int home__stab_check_image(const struct home_stab_image *im);
+#endif

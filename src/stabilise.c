@@ -1,0 +1,482 @@
+/* Live electronic image stabilisation on HOME registration: camera path from per-frame
+ * similarities, constant-velocity Kalman filter plus fixed-lag RTS smoothing over the lookahead,
+ * crop-window constraint, hold-on-failure. See include/home_stab.h for the contract. */
+#include "home_stab.h"
+#include "stab_warp.h"
+#include <math.h>
+#include <string.h>
+
+#define STAB_MAGIC 0x48535442u            /* "HSTB" */
+#define STAB_INIT_VEL_VAR 25.0            /* prior variance of the path velocity, (px/frame)^2 */
+#define STAB_FIT_GRID 5                   /* similarity fitted to H on a 5x5 grid of the frame */
+#define STAB_BISECT_STEPS 30
+
+/* One frame of path history. Path components are normalised to pixels (angle and log scale
+ * times the half diagonal) so that one filter covariance serves all four of them. */
+typedef struct stab_slot {
+    long frame;
+    int status;
+    home_stab_sim raw;            /* camera path: frame 0 -> this frame */
+    double xf[4][2], xp[4][2];    /* filtered / predicted (position, velocity) per component */
+    double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
+} stab_slot;
+
+struct home_stab {
+    uint32_t magic;
+    home_stab_config cfg;
+    home_context *home;
+    home_features *feat[2];       /* [0] previous frame, [1] current: swapped by pointer */
+    uint8_t *small;               /* downscaled luma */
+    int small_w, small_h;
+    stab_slot *ring;              /* lookahead + 1 slots, frame n in ring[n % len] */
+    int ring_len;
+    long pushed, emitted;
+    double q, r, norm;            /* process / measurement noise, px per radian or log-scale */
+};
+
+static size_t align_up(size_t n) { return (n + HOME_ARENA_ALIGN - 1) / HOME_ARENA_ALIGN * HOME_ARENA_ALIGN; }
+
+static int is_finite_in(double v, double lo, double hi) { return isfinite(v) && v >= lo && v <= hi; }
+
+int home_stab_default_config(home_stab_config *cfg, int width, int height)
+{
+    if (!cfg) return HOME_E_NULL;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->width = width;
+    cfg->height = height;
+    cfg->margin = 0.10f;
+    cfg->smoothing = 15.0f;
+    cfg->lookahead = 0;
+    cfg->downscale = width > 480 ? 2 : 1;
+    cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 500 ? HOME_MAX_KEYPOINTS_PER_SIGN : 500;
+    cfg->min_inliers = 20;
+    cfg->max_shift = 0.15f;
+    cfg->max_rotation = 0.15f;
+    cfg->max_zoom = 0.10f;
+    cfg->max_residual = 0.025f * (float)width;
+    return home_stab_validate_config(cfg) == HOME_E_SIZE ? HOME_E_SIZE : HOME_OK;
+}
+
+/* The HOME configuration registration runs with. */
+static int home_config_for(const home_stab_config *cfg, home_config *h)
+{
+    int f = cfg->downscale, status;
+    if (f != 1 && f != 2 && f != 4) return HOME_E_CONFIG;
+    status = home_default_config(h, cfg->width / f, cfg->height / f);
+    if (status != HOME_OK) return status;
+    h->keypoints_per_sign = cfg->keypoints_per_sign;
+    h->min_inliers = cfg->min_inliers;
+    h->clock = cfg->clock;
+    h->clock_user = cfg->clock_user;
+    return home_validate_config(h);
+}
+
+int home_stab_validate_config(const home_stab_config *cfg)
+{
+    home_config h;
+    if (!cfg) return HOME_E_NULL;
+    if (cfg->width < HOME_MIN_SIDE || cfg->height < HOME_MIN_SIDE || cfg->width > HOME_MAX_SIDE ||
+        cfg->height > HOME_MAX_SIDE || cfg->width % 2 || cfg->height % 2)
+        return HOME_E_SIZE;
+    if (!is_finite_in(cfg->margin, 0.0, 0.4) || !is_finite_in(cfg->smoothing, 1.0, 1000.0) ||
+        cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD ||
+        !is_finite_in(cfg->max_shift, 0.0, 1.0) || !is_finite_in(cfg->max_rotation, 0.0, 1.6) ||
+        !is_finite_in(cfg->max_zoom, 0.0, 1.0) || !is_finite_in(cfg->max_residual, 0.0, 1e6))
+        return HOME_E_CONFIG;
+    return home_config_for(cfg, &h);
+}
+
+typedef struct stab_layout {
+    size_t stab, home, feat, small, ring, total;
+    size_t home_bytes;
+} stab_layout;
+
+static void plan(const home_stab_config *cfg, const home_config *h, stab_layout *l)
+{
+    size_t at = 0;
+    l->stab = at; at = align_up(at + sizeof(home_stab));
+    l->home_bytes = home_arena_size(h);
+    l->home = at; at = align_up(at + l->home_bytes);
+    l->feat = at; at = align_up(at + 2 * sizeof(home_features));
+    l->small = at; at = align_up(at + (size_t)h->width * (size_t)h->height);
+    l->ring = at; at = align_up(at + (size_t)(cfg->lookahead + 1) * sizeof(stab_slot));
+    l->total = at;
+}
+
+size_t home_stab_arena_size(const home_stab_config *cfg)
+{
+    home_config h;
+    stab_layout l;
+    if (home_stab_validate_config(cfg) != HOME_OK) return 0;
+    home_config_for(cfg, &h);
+    plan(cfg, &h, &l);
+    return l.total;
+}
+
+int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, size_t arena_bytes,
+                   size_t *needed)
+{
+    home_config h;
+    stab_layout l;
+    home_stab *st;
+    unsigned char *base = (unsigned char *)arena;
+    int status;
+    if (needed) *needed = 0;
+    if (!out || !cfg || !arena) return HOME_E_NULL;
+    *out = NULL;
+    if ((status = home_stab_validate_config(cfg)) != HOME_OK) return status;
+    if ((uintptr_t)arena % HOME_ARENA_ALIGN) return HOME_E_ARENA_ALIGN;
+    home_config_for(cfg, &h);
+    plan(cfg, &h, &l);
+    if (needed) *needed = l.total;
+    if (arena_bytes < l.total) return HOME_E_ARENA_SMALL;
+
+    st = (home_stab *)(void *)(base + l.stab);
+    memset(st, 0, sizeof *st);
+    st->cfg = *cfg;
+    status = home_init(&st->home, &h, base + l.home, l.home_bytes, NULL);
+    if (status != HOME_OK) return status;
+    st->feat[0] = (home_features *)(void *)(base + l.feat);
+    st->feat[1] = st->feat[0] + 1;
+    memset(st->feat[0], 0, 2 * sizeof(home_features));
+    st->small = base + l.small;
+    st->small_w = h.width;
+    st->small_h = h.height;
+    st->ring = (stab_slot *)(void *)(base + l.ring);
+    st->ring_len = cfg->lookahead + 1;
+    /* Kalman bandwidth ~ (q/r)^(1/4) per frame for the constant-velocity model */
+    st->r = 1.0;
+    st->q = 1.0 / pow(cfg->smoothing, 4.0);
+    st->norm = 0.5 * sqrt((double)cfg->width * cfg->width + (double)cfg->height * cfg->height);
+    st->magic = STAB_MAGIC;
+    *out = st;
+    return HOME_OK;
+}
+
+int home_stab_reset(home_stab *st)
+{
+    if (!st) return HOME_E_NULL;
+    if (st->magic != STAB_MAGIC) return HOME_E_STATE;
+    st->pushed = st->emitted = 0;
+    return HOME_OK;
+}
+
+/* ---- similarities about the frame centre ---- */
+
+/* b after a */
+static home_stab_sim sim_compose(const home_stab_sim *b, const home_stab_sim *a)
+{
+    home_stab_sim r;
+    double s = exp(b->log_scale), c = cos(b->angle), n = sin(b->angle);
+    r.angle = a->angle + b->angle;
+    r.log_scale = a->log_scale + b->log_scale;
+    r.tx = s * (c * a->tx - n * a->ty) + b->tx;
+    r.ty = s * (n * a->tx + c * a->ty) + b->ty;
+    return r;
+}
+
+static home_stab_sim sim_inverse(const home_stab_sim *a)
+{
+    home_stab_sim r;
+    double s = exp(-a->log_scale), c = cos(a->angle), n = sin(a->angle);
+    r.angle = -a->angle;
+    r.log_scale = -a->log_scale;
+    r.tx = -s * (c * a->tx + n * a->ty);
+    r.ty = -s * (-n * a->tx + c * a->ty);
+    return r;
+}
+
+static home_stab_sim sim_scaled(const home_stab_sim *a, double k)
+{
+    home_stab_sim r;
+    r.tx = k * a->tx; r.ty = k * a->ty; r.angle = k * a->angle; r.log_scale = k * a->log_scale;
+    return r;
+}
+
+void home_stab_sim_to_matrix(const home_stab_sim *s, int width, int height, double *m)
+{
+    double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+    double k = exp(s->log_scale), a = k * cos(s->angle), b = k * sin(s->angle);
+    m[0] = a; m[1] = -b; m[2] = cx + s->tx - a * cx + b * cy;
+    m[3] = b; m[4] = a;  m[5] = cy + s->ty - b * cx - a * cy;
+    m[6] = 0; m[7] = 0;  m[8] = 1;
+}
+
+static void apply(const double *h, double x, double y, double *u, double *v)
+{
+    double w = h[6] * x + h[7] * y + h[8];
+    *u = (h[0] * x + h[1] * y + h[2]) / w;
+    *v = (h[3] * x + h[4] * y + h[5]) / w;
+}
+
+/* Least-squares similarity through the points a grid of the full frame reaches under HOME's H
+ * (found on the downscaled frame). Returns the RMS residual in px, or -1 if H is unusable. */
+static double fit_similarity(const home_stab *st, const double *h, home_stab_sim *out)
+{
+    const double f = st->cfg.downscale, off = 0.5 * (f - 1);
+    const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
+    double px[STAB_FIT_GRID * STAB_FIT_GRID][2], qx[STAB_FIT_GRID * STAB_FIT_GRID][2];
+    double mp[2] = {0, 0}, mq[2] = {0, 0}, spp = 0, sa = 0, sb = 0, a, b, res = 0;
+    const int n = STAB_FIT_GRID * STAB_FIT_GRID;
+    int i, j, k = 0;
+    for (j = 0; j < STAB_FIT_GRID; j++)
+        for (i = 0; i < STAB_FIT_GRID; i++, k++) {
+            double x = (st->cfg.width - 1) * (double)i / (STAB_FIT_GRID - 1);
+            double y = (st->cfg.height - 1) * (double)j / (STAB_FIT_GRID - 1);
+            double w = h[6] * (x - off) / f + h[7] * (y - off) / f + h[8], u, v;
+            if (!(w > 1e-6)) return -1.0;   /* grid point crosses the horizon of H */
+            apply(h, (x - off) / f, (y - off) / f, &u, &v);
+            px[k][0] = x - cx; px[k][1] = y - cy;
+            qx[k][0] = f * u + off - cx; qx[k][1] = f * v + off - cy;
+            mp[0] += px[k][0]; mp[1] += px[k][1]; mq[0] += qx[k][0]; mq[1] += qx[k][1];
+        }
+    mp[0] /= n; mp[1] /= n; mq[0] /= n; mq[1] /= n;
+    for (k = 0; k < n; k++) {
+        double p0 = px[k][0] - mp[0], p1 = px[k][1] - mp[1], q0 = qx[k][0] - mq[0], q1 = qx[k][1] - mq[1];
+        spp += p0 * p0 + p1 * p1;
+        sa += p0 * q0 + p1 * q1;
+        sb += p0 * q1 - p1 * q0;
+    }
+    a = sa / spp;
+    b = sb / spp;
+    if (!(a * a + b * b > 1e-12) || !isfinite(a) || !isfinite(b)) return -1.0;
+    out->angle = atan2(b, a);
+    out->log_scale = 0.5 * log(a * a + b * b);
+    out->tx = mq[0] - (a * mp[0] - b * mp[1]);
+    out->ty = mq[1] - (b * mp[0] + a * mp[1]);
+    for (k = 0; k < n; k++) {
+        double u = a * px[k][0] - b * px[k][1] + out->tx - qx[k][0];
+        double v = b * px[k][0] + a * px[k][1] + out->ty - qx[k][1];
+        res += u * u + v * v;
+    }
+    return sqrt(res / n);
+}
+
+/* Box-average the frame's luma into st->small; returns the image registration reads. */
+static const uint8_t *registration_luma(home_stab *st, const home_stab_image *im, ptrdiff_t *stride)
+{
+    const int f = st->cfg.downscale, step = im->format == HOME_STAB_YUYV ? 2 : 1;
+    const uint8_t *y = im->plane[0];
+    int i, j, a, b;
+    if (f == 1 && step == 1) {
+        *stride = im->stride[0];
+        return y;
+    }
+    for (j = 0; j < st->small_h; j++)
+        for (i = 0; i < st->small_w; i++) {
+            unsigned sum = 0;
+            for (b = 0; b < f; b++) {
+                const uint8_t *row = y + (ptrdiff_t)(j * f + b) * im->stride[0];
+                for (a = 0; a < f; a++) sum += row[(ptrdiff_t)(i * f + a) * step];
+            }
+            st->small[(ptrdiff_t)j * st->small_w + i] = (uint8_t)((sum + (unsigned)(f * f / 2)) / (unsigned)(f * f));
+        }
+    *stride = st->small_w;
+    return st->small;
+}
+
+/* ---- path filter ---- */
+
+static void path_components(const home_stab *st, const home_stab_sim *s, double *z)
+{
+    z[0] = s->tx; z[1] = s->ty; z[2] = s->angle * st->norm; z[3] = s->log_scale * st->norm;
+}
+
+static void kalman_step(const home_stab *st, const stab_slot *prev, stab_slot *cur)
+{
+    double z[4], k0, k1, sv;
+    int c;
+    path_components(st, &cur->raw, z);
+    if (!prev) {
+        for (c = 0; c < 4; c++) {
+            cur->xp[c][0] = cur->xf[c][0] = z[c];
+            cur->xp[c][1] = cur->xf[c][1] = 0.0;
+        }
+        cur->pp[0] = cur->pf[0] = st->r;
+        cur->pp[1] = cur->pf[1] = 0.0;
+        cur->pp[2] = cur->pf[2] = STAB_INIT_VEL_VAR;
+        return;
+    }
+    /* predict with F = [1 1; 0 1], Q = q [1/3 1/2; 1/2 1] (white acceleration, one frame) */
+    cur->pp[0] = prev->pf[0] + 2.0 * prev->pf[1] + prev->pf[2] + st->q / 3.0;
+    cur->pp[1] = prev->pf[1] + prev->pf[2] + st->q / 2.0;
+    cur->pp[2] = prev->pf[2] + st->q;
+    sv = cur->pp[0] + st->r;
+    k0 = cur->pp[0] / sv;
+    k1 = cur->pp[1] / sv;
+    for (c = 0; c < 4; c++) {
+        double innov;
+        cur->xp[c][0] = prev->xf[c][0] + prev->xf[c][1];
+        cur->xp[c][1] = prev->xf[c][1];
+        innov = z[c] - cur->xp[c][0];
+        cur->xf[c][0] = cur->xp[c][0] + k0 * innov;
+        cur->xf[c][1] = cur->xp[c][1] + k1 * innov;
+    }
+    cur->pf[0] = (1.0 - k0) * cur->pp[0];
+    cur->pf[1] = (1.0 - k0) * cur->pp[1];
+    cur->pf[2] = cur->pp[2] - k1 * cur->pp[1];
+}
+
+static stab_slot *slot_of(const home_stab *st, long frame) { return &st->ring[frame % st->ring_len]; }
+
+/* Fixed-lag RTS smoothing: the estimate of frame m's path given every frame up to last. */
+static home_stab_sim smoothed_path(const home_stab *st, long m, long last)
+{
+    double xs[4][2];
+    home_stab_sim s;
+    long k;
+    int c;
+    memcpy(xs, slot_of(st, last)->xf, sizeof xs);
+    for (k = last - 1; k >= m; k--) {
+        const stab_slot *a = slot_of(st, k), *b = slot_of(st, k + 1);
+        /* C = Pf F^T Pp(k+1)^-1 */
+        double f00 = a->pf[0] + a->pf[1], f01 = a->pf[1], f10 = a->pf[1] + a->pf[2], f11 = a->pf[2];
+        double det = b->pp[0] * b->pp[2] - b->pp[1] * b->pp[1];
+        double i00 = b->pp[2] / det, i01 = -b->pp[1] / det, i11 = b->pp[0] / det;
+        double c00 = f00 * i00 + f01 * i01, c01 = f00 * i01 + f01 * i11;
+        double c10 = f10 * i00 + f11 * i01, c11 = f10 * i01 + f11 * i11;
+        for (c = 0; c < 4; c++) {
+            double d0 = xs[c][0] - b->xp[c][0], d1 = xs[c][1] - b->xp[c][1];
+            xs[c][0] = a->xf[c][0] + c00 * d0 + c01 * d1;
+            xs[c][1] = a->xf[c][1] + c10 * d0 + c11 * d1;
+        }
+    }
+    s.tx = xs[0][0];
+    s.ty = xs[1][0];
+    s.angle = xs[2][0] / st->norm;
+    s.log_scale = xs[3][0] / st->norm;
+    return s;
+}
+
+/* output pixel -> input pixel for a correction (virtual camera -> real camera) share k */
+static void crop_warp(const home_stab *st, const home_stab_sim *corr, double k, double *m)
+{
+    const double z = 1.0 - 2.0 * st->cfg.margin;
+    const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
+    home_stab_sim part = sim_scaled(corr, k);
+    double d[9];
+    int i;
+    home_stab_sim_to_matrix(&part, st->cfg.width, st->cfg.height, d);
+    /* d after the zoom q -> c + z (q - c) */
+    for (i = 0; i < 2; i++) {
+        m[3 * i + 2] = d[3 * i + 0] * cx * (1 - z) + d[3 * i + 1] * cy * (1 - z) + d[3 * i + 2];
+        m[3 * i + 0] = d[3 * i + 0] * z;
+        m[3 * i + 1] = d[3 * i + 1] * z;
+    }
+    m[6] = 0; m[7] = 0; m[8] = 1;
+}
+
+static int window_inside(const home_stab *st, const double *m)
+{
+    const double xmax = st->cfg.width - 1, ymax = st->cfg.height - 1;
+    int i;
+    for (i = 0; i < 4; i++) {
+        double x = (i & 1) ? xmax : 0.0, y = (i & 2) ? ymax : 0.0, u, v;
+        apply(m, x, y, &u, &v);
+        if (!(u >= 0.0 && u <= xmax && v >= 0.0 && v <= ymax)) return 0;
+    }
+    return 1;
+}
+
+static void emit(home_stab *st, long last, home_stab_output *out)
+{
+    const long m = st->emitted;
+    const stab_slot *slot = slot_of(st, m);
+    home_stab_sim inv_smooth, corr;
+    double lo = 0.0, hi = 1.0;
+    int i;
+    out->ready = 1;
+    out->frame = m;
+    out->raw = slot->raw;
+    out->motion_status = slot->status;
+    out->smooth = smoothed_path(st, m, last);
+    /* the real camera seen from the virtual (smoothed) one: raw after smooth^-1 */
+    inv_smooth = sim_inverse(&out->smooth);
+    corr = sim_compose(&slot->raw, &inv_smooth);
+    crop_warp(st, &corr, 1.0, out->warp);
+    if (!window_inside(st, out->warp)) {
+        /* the largest share of the correction that keeps the window inside (0 always does) */
+        for (i = 0; i < STAB_BISECT_STEPS; i++) {
+            double mid = 0.5 * (lo + hi), w[9];
+            crop_warp(st, &corr, mid, w);
+            if (window_inside(st, w)) lo = mid; else hi = mid;
+        }
+        hi = lo;
+        crop_warp(st, &corr, lo, out->warp);
+    }
+    out->correction_used = hi;
+    st->emitted++;
+}
+
+static int check_stab(const home_stab *st, const home_stab_output *out)
+{
+    if (!st || !out) return HOME_E_NULL;
+    return st->magic == STAB_MAGIC ? HOME_OK : HOME_E_STATE;
+}
+
+int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output *out)
+{
+    const uint8_t *luma;
+    ptrdiff_t stride;
+    home_features *swap;
+    home_stab_sim motion = {0, 0, 0, 0};
+    stab_slot *slot;
+    double t0 = 0;
+    long n;
+    int status = check_stab(st, out);
+    if (status != HOME_OK) return status;
+    if ((status = home__stab_check_image(frame)) != HOME_OK) return status;
+    if (frame->width != st->cfg.width || frame->height != st->cfg.height) return HOME_E_MISMATCH;
+
+    memset(out, 0, sizeof *out);
+    if (st->cfg.clock) t0 = st->cfg.clock(st->cfg.clock_user);
+    luma = registration_luma(st, frame, &stride);
+    status = home_extract(st->home, luma, stride, st->feat[1]);
+    if (status != HOME_OK) return status;
+    n = st->pushed;
+    out->newest_status = HOME_STAB_MOTION_FIRST;
+    if (n > 0) {
+        status = home_match(st->home, st->feat[0], st->feat[1], &out->reg);
+        if (status != HOME_OK) return status;
+        out->newest_status = HOME_STAB_MOTION_FAILED;
+        if (out->reg.ok) {
+            home_stab_sim s;
+            double res = fit_similarity(st, out->reg.H, &s);
+            out->newest_status = HOME_STAB_MOTION_IMPLAUSIBLE;
+            if (res >= 0.0 && res <= st->cfg.max_residual &&
+                hypot(s.tx, s.ty) <= st->cfg.max_shift * st->cfg.width &&
+                fabs(s.angle) <= st->cfg.max_rotation && fabs(s.log_scale) <= st->cfg.max_zoom) {
+                out->newest_status = HOME_STAB_MOTION_OK;
+                motion = s;
+            }
+        }
+    }
+    swap = st->feat[0];
+    st->feat[0] = st->feat[1];
+    st->feat[1] = swap;
+    if (st->cfg.clock) out->ms_register = st->cfg.clock(st->cfg.clock_user) - t0;
+
+    slot = slot_of(st, n);
+    slot->frame = n;
+    slot->status = out->newest_status;
+    if (n == 0) {
+        memset(&slot->raw, 0, sizeof slot->raw);
+        kalman_step(st, NULL, slot);
+    } else {
+        const stab_slot *prev = slot_of(st, n - 1);
+        slot->raw = sim_compose(&motion, &prev->raw);
+        kalman_step(st, prev, slot);
+    }
+    st->pushed = n + 1;
+    if (n - st->emitted >= st->cfg.lookahead) emit(st, n, out);
+    return HOME_OK;
+}
+
+int home_stab_flush(home_stab *st, home_stab_output *out)
+{
+    int status = check_stab(st, out);
+    if (status != HOME_OK) return status;
+    memset(out, 0, sizeof *out);
+    if (st->emitted < st->pushed) emit(st, st->pushed - 1, out);
+    return HOME_OK;
+}

@@ -1,0 +1,410 @@
+/* Stabiliser tests (home-stab-tests): warp kernels against a floating-point reference and across
+ * formats, the path filter on synthetic shaky clips with known camera motion (residual jitter,
+ * crop window inside the frame, latency = lookahead, hold on failure), API contract.
+ * Built only with -DHOME_STAB_TESTS (mk/stab.mk); in home-tests this file compiles to nothing. */
+#ifdef HOME_STAB_TESTS
+#include "home_stab.h"
+#include "stab_clip.h"
+#include "stab_warp.h"
+#include "synth.h"
+#include "test.h"
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+int test_failures;
+
+#define CW 256
+#define CH 144
+#define CLIP_FRAMES 72
+
+static union { unsigned char bytes[8u << 20]; double align; } arena;
+static uint8_t clip[CLIP_FRAMES][CW * CH * 3 / 2];
+static double clip_g[CLIP_FRAMES][9];
+
+static home_stab *make_stab(int lookahead, int downscale)
+{
+    home_stab_config cfg;
+    home_stab *st = NULL;
+    home_stab_default_config(&cfg, CW, CH);
+    cfg.lookahead = lookahead;
+    cfg.downscale = downscale;
+    if (home_stab_init(&st, &cfg, arena.bytes, sizeof arena.bytes, NULL) != HOME_OK) return NULL;
+    return st;
+}
+
+static void grey_image(uint8_t *buf, home_stab_image *im)
+{
+    memset(im, 0, sizeof *im);
+    im->format = HOME_STAB_I420;
+    im->width = CW;
+    im->height = CH;
+    im->plane[0] = buf;
+    im->plane[1] = buf + CW * CH;
+    im->plane[2] = buf + CW * CH + CW * CH / 4;
+    im->stride[0] = CW;
+    im->stride[1] = im->stride[2] = CW / 2;
+}
+
+/* Render the shaky clip once: structured scene, 3 px / 0.3 deg jitter, a 40 px pan. */
+static void render_clip(void)
+{
+    static int done;
+    stab_clip_motion m = {CLIP_FRAMES, 3.0, 0.3, 40.0, 5};
+    int t;
+    if (done) return;
+    for (t = 0; t < CLIP_FRAMES; t++) {
+        double intent[9];
+        stab_clip_camera(&m, t, CW, CH, clip_g[t], intent);
+        synth_render(SYNTH_STRUCTURED, 1, clip_g[t], 1.0, (uint64_t)t + 1, clip[t], CW, CH, CW);
+        memset(clip[t] + CW * CH, 128, CW * CH / 2);
+    }
+    done = 1;
+}
+
+static int corners_inside(const double *w)
+{
+    int i;
+    for (i = 0; i < 4; i++) {
+        double x = (i & 1) ? CW - 1 : 0, y = (i & 2) ? CH - 1 : 0;
+        double u = w[0] * x + w[1] * y + w[2], v = w[3] * x + w[4] * y + w[5];
+        if (!(u >= -1e-9 && u <= CW - 1 + 1e-9 && v >= -1e-9 && v <= CH - 1 + 1e-9)) return 0;
+    }
+    return 1;
+}
+
+typedef struct run_result {
+    double warp[CLIP_FRAMES][9];
+    int status[CLIP_FRAMES];
+    int emitted, order_ok, latency_ok, inside;
+} run_result;
+
+/* Stabilise the clip (frames flat_from..flat_to replaced by flat grey when flat_to >= 0). */
+static void run_clip(int lookahead, int downscale, int flat_from, int flat_to, run_result *r)
+{
+    static uint8_t flat[CW * CH * 3 / 2];
+    home_stab *st = make_stab(lookahead, downscale);
+    home_stab_output o;
+    home_stab_image im;
+    int t;
+    memset(r, 0, sizeof *r);
+    r->order_ok = r->latency_ok = r->inside = 1;
+    memset(flat, 128, sizeof flat);
+    CHECK(st != NULL);
+    if (!st) return;
+    render_clip();
+    for (t = 0; t < CLIP_FRAMES; t++) {
+        grey_image(t >= flat_from && t <= flat_to ? flat : clip[t], &im);
+        CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_OK);
+        r->status[t] = o.newest_status;
+        if (o.ready != (t >= lookahead)) r->latency_ok = 0;
+        if (!o.ready) continue;
+        if (o.frame != t - lookahead || o.frame != r->emitted) r->order_ok = 0;
+        memcpy(r->warp[o.frame], o.warp, sizeof o.warp);
+        r->inside &= corners_inside(o.warp) && o.correction_used >= 0 && o.correction_used <= 1;
+        r->emitted++;
+    }
+    while (home_stab_flush(st, &o) == HOME_OK && o.ready) {
+        if (o.frame != r->emitted) r->order_ok = 0;
+        memcpy(r->warp[o.frame], o.warp, sizeof o.warp);
+        r->inside &= corners_inside(o.warp);
+        r->emitted++;
+    }
+}
+
+/* Jitter of the camera the output shows: ref -> output is warp^-1 after g. */
+static double output_jitter(const run_result *r)
+{
+    static double path[CLIP_FRAMES][3];
+    int t;
+    for (t = 0; t < CLIP_FRAMES; t++) {
+        double inv[9], o[9];
+        int i, j, k;
+        synth_invert(r->warp[t], inv);
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++)
+                for (o[3 * i + j] = 0, k = 0; k < 3; k++) o[3 * i + j] += inv[3 * i + k] * clip_g[t][3 * k + j];
+        stab_clip_components(o, CW, CH, path[t]);
+    }
+    return stab_clip_jitter((const double (*)[3])path, CLIP_FRAMES, 4.0, 6);
+}
+
+static double input_jitter(void)
+{
+    static double path[CLIP_FRAMES][3];
+    int t;
+    render_clip();
+    for (t = 0; t < CLIP_FRAMES; t++) stab_clip_components(clip_g[t], CW, CH, path[t]);
+    return stab_clip_jitter((const double (*)[3])path, CLIP_FRAMES, 4.0, 6);
+}
+
+static void test_jitter_reduced_causal(void)
+{
+    static run_result r;
+    double in = input_jitter(), out;
+    int t, ok = 0;
+    run_clip(0, 1, 0, -1, &r);
+    out = output_jitter(&r);
+    for (t = 1; t < CLIP_FRAMES; t++) ok += r.status[t] == HOME_STAB_MOTION_OK;
+    printf("    jitter in %.3f px, out %.3f px (causal), %d/%d registered\n", in, out, ok, CLIP_FRAMES - 1);
+    CHECK(in > 2.0);
+    CHECK_LT(out, 0.35 * in);
+    CHECK(ok >= CLIP_FRAMES - 3);
+    CHECK(r.inside);
+    CHECK(r.order_ok && r.latency_ok);
+    CHECK_EQ_INT(r.emitted, CLIP_FRAMES);
+}
+
+static void test_lookahead_latency_and_gain(void)
+{
+    static run_result causal, ahead;
+    double j0, j1;
+    run_clip(0, 1, 0, -1, &causal);
+    run_clip(12, 1, 0, -1, &ahead);
+    j0 = output_jitter(&causal);
+    j1 = output_jitter(&ahead);
+    printf("    jitter causal %.3f px, lookahead 12: %.3f px\n", j0, j1);
+    CHECK(ahead.latency_ok && ahead.order_ok);
+    CHECK_EQ_INT(ahead.emitted, CLIP_FRAMES);
+    CHECK(ahead.inside);
+    CHECK_LT(j1, j0);
+}
+
+static void test_downscaled_registration(void)
+{
+    static run_result r;
+    double in = input_jitter(), out;
+    run_clip(0, 2, 0, -1, &r);
+    out = output_jitter(&r);
+    printf("    jitter with registration at 1/2 size: %.3f px\n", out);
+    CHECK_LT(out, 0.5 * in);
+    CHECK(r.inside);
+}
+
+/* Flat frames cannot be registered: the path holds, every warp stays valid, inside the frame,
+ * and the correction changes smoothly (no garbage, no jump). */
+static void test_hold_on_failure(void)
+{
+    static run_result r;
+    double max_step = 0;
+    int t, held = 0;
+    run_clip(0, 1, 30, 37, &r);
+    for (t = 30; t <= 38; t++) held += r.status[t] == HOME_STAB_MOTION_FAILED || r.status[t] == HOME_STAB_MOTION_IMPLAUSIBLE;
+    for (t = 1; t < CLIP_FRAMES; t++) {
+        double step = hypot(r.warp[t][2] - r.warp[t - 1][2], r.warp[t][5] - r.warp[t - 1][5]);
+        if (step > max_step) max_step = step;
+    }
+    printf("    %d frames held, largest frame-to-frame change of the warp %.2f px\n", held, max_step);
+    CHECK(held >= 9);
+    CHECK(r.inside);
+    CHECK_EQ_INT(r.emitted, CLIP_FRAMES);
+    CHECK_LT(max_step, 0.1 * CW);
+}
+
+static void test_deterministic(void)
+{
+    static run_result a, b;
+    run_clip(4, 1, 0, -1, &a);
+    run_clip(4, 1, 0, -1, &b);
+    CHECK(memcmp(a.warp, b.warp, sizeof a.warp) == 0);
+}
+
+/* ---- warp kernels ---- */
+
+static double ref_sample(const uint8_t *p, ptrdiff_t stride, int step, int w, int h, double x, double y)
+{
+    int xi, yi;
+    double fx, fy;
+    x = x < 0 ? 0 : x > w - 1 ? w - 1 : x;
+    y = y < 0 ? 0 : y > h - 1 ? h - 1 : y;
+    xi = (int)x < w - 1 ? (int)x : w - 2;
+    yi = (int)y < h - 1 ? (int)y : h - 2;
+    fx = x - xi;
+    fy = y - yi;
+    p += yi * stride + xi * step;
+    return (p[0] * (1 - fx) + p[step] * fx) * (1 - fy) + (p[stride] * (1 - fx) + p[stride + step] * fx) * fy;
+}
+
+static void test_warp_matches_reference(void)
+{
+    static uint8_t src[CW * CH * 3 / 2], dst[CW * CH * 3 / 2];
+    home_stab_image a, b;
+    double worst = 0;
+    int trial, x, y;
+    synth_rng rng;
+    synth_seed(&rng, 11);
+    render_clip();
+    memcpy(src, clip[3], sizeof src);
+    for (x = 0; x < CW * CH / 2; x++) src[CW * CH + x] = (uint8_t)(x * 7);   /* chroma pattern */
+    grey_image(src, &a);
+    grey_image(dst, &b);
+    for (trial = 0; trial < 20; trial++) {
+        home_stab_sim s;
+        double m[9];
+        s.tx = 20 * (synth_uniform(&rng) - 0.5);
+        s.ty = 20 * (synth_uniform(&rng) - 0.5);
+        s.angle = 0.2 * (synth_uniform(&rng) - 0.5);
+        s.log_scale = 0.3 * (synth_uniform(&rng) - 0.5);
+        home_stab_sim_to_matrix(&s, CW, CH, m);
+        CHECK_EQ_INT(home_stab_warp(m, &a, &b), HOME_OK);
+        for (y = 0; y < CH; y++)
+            for (x = 0; x < CW; x++) {
+                double u = m[0] * x + m[1] * y + m[2], v = m[3] * x + m[4] * y + m[5];
+                double d = fabs(dst[y * CW + x] - ref_sample(src, CW, 1, CW, CH, u, v));
+                if (d > worst) worst = d;
+            }
+        for (y = 0; y < CH / 2; y++)   /* chroma: centre-sited, half resolution */
+            for (x = 0; x < CW / 2; x++) {
+                double u = m[0] * (2 * x + 0.5) + m[1] * (2 * y + 0.5) + m[2];
+                double v = m[3] * (2 * x + 0.5) + m[4] * (2 * y + 0.5) + m[5];
+                double d = fabs(dst[CW * CH + y * CW / 2 + x] -
+                                ref_sample(src + CW * CH, CW / 2, 1, CW / 2, CH / 2, (u - 0.5) / 2, (v - 0.5) / 2));
+                if (d > worst) worst = d;
+            }
+    }
+    printf("    largest difference from floating-point bilinear: %.3f grey levels\n", worst);
+    CHECK_LT(worst, 1.5);
+}
+
+static void test_warp_identity_and_shift(void)
+{
+    static uint8_t src[CW * CH * 3 / 2], dst[CW * CH * 3 / 2];
+    home_stab_image a, b;
+    double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, shift[9] = {1, 0, 4, 0, 1, -2, 0, 0, 1};
+    int x, y, bad = 0;
+    render_clip();
+    memcpy(src, clip[0], sizeof src);
+    for (x = 0; x < CW * CH / 2; x++) src[CW * CH + x] = (uint8_t)(x * 13);
+    grey_image(src, &a);
+    grey_image(dst, &b);
+    CHECK_EQ_INT(home_stab_warp(id, &a, &b), HOME_OK);
+    CHECK(memcmp(src, dst, sizeof src) == 0);
+    CHECK_EQ_INT(home_stab_warp(shift, &a, &b), HOME_OK);
+    for (y = 0; y < CH - 2; y++)
+        for (x = 0; x < CW - 4; x++) bad += dst[(y + 2) * CW + x] != src[y * CW + x + 4];
+    for (y = 0; y < CH / 2 - 1; y++)   /* 4, -2 luma px = 2, -1 chroma px: exact */
+        for (x = 0; x < CW / 2 - 2; x++) bad += dst[CW * CH + (y + 1) * CW / 2 + x] != src[CW * CH + y * CW / 2 + x + 2];
+    CHECK_EQ_INT(bad, 0);
+}
+
+/* The same picture as I420, NV12 and YUYV warps to the same samples. */
+static void test_warp_formats_agree(void)
+{
+    static uint8_t i420[CW * CH * 3 / 2], nv12[CW * CH * 3 / 2], yuyv[CW * CH * 2];
+    static uint8_t o420[CW * CH * 3 / 2], onv[CW * CH * 3 / 2], oyuyv[CW * CH * 2];
+    home_stab_image a, b, c, d, e, f;
+    home_stab_sim s = {3.3, -2.7, 0.03, 0.05};
+    double m[9];
+    int x, y, bad = 0;
+    render_clip();
+    memcpy(i420, clip[5], CW * CH);
+    for (x = 0; x < CW * CH / 4; x++) { i420[CW * CH + x] = (uint8_t)(x * 3); i420[CW * CH * 5 / 4 + x] = (uint8_t)(x * 5 + 1); }
+    memcpy(nv12, i420, CW * CH);
+    for (x = 0; x < CW * CH / 4; x++) { nv12[CW * CH + 2 * x] = i420[CW * CH + x]; nv12[CW * CH + 2 * x + 1] = i420[CW * CH * 5 / 4 + x]; }
+    for (y = 0; y < CH; y++)
+        for (x = 0; x < CW; x++) yuyv[y * 2 * CW + 2 * x] = i420[y * CW + x];
+    for (y = 0; y < CH; y++)
+        for (x = 0; x < CW / 2; x++) { yuyv[y * 2 * CW + 4 * x + 1] = 0; yuyv[y * 2 * CW + 4 * x + 3] = 0; }
+    grey_image(i420, &a); grey_image(o420, &b);
+    c = a; c.format = HOME_STAB_NV12; c.plane[0] = nv12; c.plane[1] = nv12 + CW * CH; c.stride[1] = CW;
+    d = c; d.plane[0] = onv; d.plane[1] = onv + CW * CH;
+    memset(&e, 0, sizeof e);
+    e.format = HOME_STAB_YUYV; e.width = CW; e.height = CH; e.plane[0] = yuyv; e.stride[0] = 2 * CW;
+    f = e; f.plane[0] = oyuyv;
+    home_stab_sim_to_matrix(&s, CW, CH, m);
+    CHECK_EQ_INT(home_stab_warp(m, &a, &b), HOME_OK);
+    CHECK_EQ_INT(home_stab_warp(m, &c, &d), HOME_OK);
+    CHECK_EQ_INT(home_stab_warp(m, &e, &f), HOME_OK);
+    CHECK(memcmp(o420, onv, CW * CH) == 0);
+    for (x = 0; x < CW * CH / 4; x++)
+        bad += onv[CW * CH + 2 * x] != o420[CW * CH + x] || onv[CW * CH + 2 * x + 1] != o420[CW * CH * 5 / 4 + x];
+    for (y = 0; y < CH; y++)
+        for (x = 0; x < CW; x++) bad += oyuyv[y * 2 * CW + 2 * x] != o420[y * CW + x];
+    CHECK_EQ_INT(bad, 0);
+}
+
+static void test_row_kernel_edges(void)
+{
+    /* 2x2 source: every clamped coordinate lands on an edge pixel pair with weights 0 or 256 */
+    static const uint8_t src[4] = {10, 20, 30, 40};
+    uint8_t out[4];
+    home__warp_row_c(src, 2, 1, 2, 2, -5 * 65536, -5 * 65536, 10 * 65536, 0, out, 1, 2);
+    CHECK_EQ_INT(out[0], 10);
+    CHECK_EQ_INT(out[1], 20);
+    home__warp_row_c(src, 2, 1, 2, 2, 1 << 15, 1 << 15, 0, 0, out, 1, 1);
+    CHECK_EQ_INT(out[0], 25);
+    home__warp_row_c(src, 2, 1, 2, 2, 1 << 16, 1 << 16, 0, 0, out, 1, 1);
+    CHECK_EQ_INT(out[0], 40);
+}
+
+static void test_api_contract(void)
+{
+    static uint8_t buf[CW * CH * 3 / 2];
+    home_stab_config cfg, bad;
+    home_stab *st = NULL;
+    home_stab_output o;
+    home_stab_image im, small;
+    size_t need = 0, size;
+    double affine[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, proj[9] = {1, 0, 0, 0, 1, 0, 1e-4, 0, 1};
+    double far[9] = {1, 0, 900, 0, 1, 0, 0, 0, 1}, nan_map[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    CHECK_EQ_INT(home_stab_default_config(&cfg, CW, CH), HOME_OK);
+    CHECK_EQ_INT(home_stab_validate_config(&cfg), HOME_OK);
+    size = home_stab_arena_size(&cfg);
+    CHECK(size > 0 && size < sizeof arena.bytes);
+    CHECK_EQ_INT(home_stab_init(&st, &cfg, arena.bytes, size - 1, &need), HOME_E_ARENA_SMALL);
+    CHECK_EQ_INT(need, size);
+    CHECK_EQ_INT(home_stab_init(&st, &cfg, arena.bytes + 1, size + 16, NULL), HOME_E_ARENA_ALIGN);
+    CHECK_EQ_INT(home_stab_init(&st, NULL, arena.bytes, size, NULL), HOME_E_NULL);
+    bad = cfg; bad.width = CW + 1; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_SIZE);
+    bad = cfg; bad.margin = 0.5f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.smoothing = NAN; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.lookahead = HOME_STAB_MAX_LOOKAHEAD + 1; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.downscale = 3; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.downscale = 8; CHECK(home_stab_validate_config(&bad) != HOME_OK);
+    CHECK_EQ_INT(home_stab_arena_size(&bad), 0);
+    CHECK_EQ_INT(home_stab_init(&st, &cfg, arena.bytes, size, NULL), HOME_OK);
+    grey_image(buf, &im);
+    CHECK_EQ_INT(home_stab_push(st, NULL, &o), HOME_E_NULL);
+    CHECK_EQ_INT(home_stab_push(NULL, &im, &o), HOME_E_NULL);
+    small = im; small.width = CW / 2; CHECK_EQ_INT(home_stab_push(st, &small, &o), HOME_E_MISMATCH);
+    small = im; small.stride[1] = CW / 4; CHECK_EQ_INT(home_stab_push(st, &small, &o), HOME_E_STRIDE);
+    small = im; small.format = 77; CHECK_EQ_INT(home_stab_push(st, &small, &o), HOME_E_CONFIG);
+    small = im; small.plane[2] = NULL; CHECK_EQ_INT(home_stab_push(st, &small, &o), HOME_E_NULL);
+    CHECK_EQ_INT(home_stab_warp(proj, &im, &im), HOME_E_CONFIG);
+    CHECK_EQ_INT(home_stab_warp(far, &im, &im), HOME_E_CONFIG);
+    nan_map[2] = NAN;
+    CHECK_EQ_INT(home_stab_warp(nan_map, &im, &im), HOME_E_CONFIG);
+    small = im; small.height = CH - 2; CHECK_EQ_INT(home_stab_warp(affine, &im, &small), HOME_E_MISMATCH);
+    /* a garbage-filled handle is refused, not followed */
+    memset(arena.bytes, 0x5a, 4096);
+    CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_E_STATE);
+    CHECK_EQ_INT(home_stab_flush(st, &o), HOME_E_STATE);
+}
+
+#define STAB_TESTS(X) \
+    X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
+    X(warp_formats_agree) X(jitter_reduced_causal) X(lookahead_latency_and_gain) \
+    X(downscaled_registration) X(hold_on_failure) X(deterministic)
+#define ENTRY(name) {#name, test_##name},
+static const struct { const char *name; void (*fn)(void); } tests[] = {STAB_TESTS(ENTRY)};
+
+int main(int argc, char **argv)
+{
+    int passed = 0, failed = 0;
+    size_t i;
+    for (i = 0; i < sizeof tests / sizeof tests[0]; i++) {
+        int before = test_failures, k, selected = argc < 2;
+        for (k = 1; k < argc; k++) selected |= !strcmp(argv[k], tests[i].name);
+        if (!selected) continue;
+        tests[i].fn();
+        if (test_failures == before) { passed++; printf("ok   stab_%s\n", tests[i].name); }
+        else { failed++; printf("FAIL stab_%s\n", tests[i].name); }
+        fflush(stdout);
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
+#else
+typedef int home_stab_tests_not_built; /* ISO C forbids an empty translation unit */
+#endif
