@@ -14,6 +14,7 @@
 #define FZ_SMALL_SIDE 56
 #define FZ_SMALL_THETA 48
 #define FZ_MAX_SIDE 96
+#define FZ_MAX_HOUGH_CELLS (256 * 200)
 #define FZ_MAX_STRIDE (FZ_MAX_SIDE + 16)
 #define FZ_ARENA_BYTES (6u << 20)
 
@@ -27,7 +28,9 @@ enum {
     FLAG_CORRUPT = 1 << 6,       /* corrupt features before matching */
     FLAG_RAW_SIZE = 1 << 7,      /* any width/height, in range or not */
     FLAG_VIDEO = 1 << 8,         /* extract both frames again and match: same result as the pair */
-    FLAG_CLOCK = 1 << 9          /* a timing hook is set */
+    FLAG_CLOCK = 1 << 9,         /* a timing hook is set */
+    FLAG_REFINE = 1 << 10,       /* home_refine() from a fuzzed initial H */
+    FLAG_EXACT = 1 << 11         /* the exact (pixel by pixel) Hough method */
 };
 
 static union { unsigned char bytes[FZ_ARENA_BYTES]; double align; } arena;
@@ -102,7 +105,8 @@ static void check_features(const home_config *cfg, const home_features *f)
     for (i = 0; i < f->n_pos + f->n_neg; i++) {
         const home_keypoint *kp = &f->kp[i];
         FZ_CHECK(kp->sign == (i < f->n_pos ? 1 : -1));
-        FZ_CHECK(kp->theta >= 0.0f && kp->theta < 3.1416f);
+        /* [0, pi) before rounding: a theta just below pi rounds to (float)pi (regress-theta-pi) */
+        FZ_CHECK(kp->theta >= 0.0f && kp->theta <= (float)3.14159265358979323846);
         FZ_CHECK(isfinite(kp->r) && isfinite(kp->saliency) && kp->saliency >= 0.0f);
         FZ_CHECK(kp->has_alt == 0 || kp->has_alt == 1);
         if (i != 0 && i != f->n_pos) FZ_CHECK(kp[-1].saliency >= kp->saliency);
@@ -134,9 +138,11 @@ static void check_result(const home_config *cfg, const home_result *res)
         const double *h = res->H;
         double det = h[0] * (h[4] * h[8] - h[5] * h[7]) - h[1] * (h[3] * h[8] - h[5] * h[6]) +
                      h[2] * (h[3] * h[7] - h[4] * h[6]);
-        FZ_CHECK(res->failure == HOME_FAIL_NONE);
         FZ_CHECK(h[8] == 1.0 && det > 0.0);
-        FZ_CHECK(res->inliers >= cfg->min_inliers);
+        if (res->failure == HOME_FAIL_NONE)
+            FZ_CHECK(res->inliers >= cfg->min_inliers);
+        else /* the refinement's rescue of a pair short of inliers (home.h's failure rule) */
+            FZ_CHECK(res->refined && res->failure == HOME_FAIL_FEW_INLIERS && res->inliers >= 8);
     } else {
         FZ_CHECK(res->failure >= HOME_FAIL_FEW_MATCHES && res->failure <= HOME_FAIL_DEGENERATE);
     }
@@ -148,7 +154,7 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
     for (k = 0; k < n; k++) {
         int32_t raw = (int32_t)fz_u32(r);
         float f = fz_float_bits(r);
-        switch (fz_u8(r) % 11) {
+        switch (fz_u8(r) % 16) {
         case 0: cfg->theta_bins = raw % 4096; break;
         case 1: cfg->wrap_band = raw % 1024; break;
         case 2: cfg->r_step = f; break;
@@ -159,6 +165,11 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
         case 7: cfg->threshold_start = f; break;
         case 8: cfg->threshold_final = f; break;
         case 9: cfg->min_inliers = raw % 4096; break;
+        case 10: cfg->refine_levels = raw % 16; break;
+        case 11: cfg->refine_iterations = raw % 256; break;
+        case 12: cfg->refine_trust_px = f; break;
+        case 13: cfg->simd = raw % 8; break;
+        case 14: cfg->hough_method = raw % 4; break;
         default: cfg->width = raw; break;
         }
     }
@@ -224,6 +235,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     cfg.wrap_band = cfg.theta_bins / 18;
     cfg.keypoints_per_sign = fz_range(r, 8, 200);
     cfg.min_inliers = fz_range(r, 4, 30);
+    cfg.simd = fz_range(r, HOME_SIMD_AUTO, HOME_SIMD_AVX2 + 1); /* uncompiled ones are refused */
+    if (flags & FLAG_EXACT) cfg.hough_method = HOME_HOUGH_EXACT;
     if (flags & FLAG_CLOCK) {
         cfg.clock = fake_clock;
         cfg.clock_user = &ticks;
@@ -251,8 +264,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (init == HOME_OK || init == HOME_E_ARENA_SMALL) FZ_CHECK(needed == need);
         if (init != HOME_OK) return 0;
     }
-    /* a valid config may still describe images larger than this harness's buffers */
+    /* a valid config may still describe images larger than this harness's buffers, or a Hough
+     * image so large that executions would crawl (fuzzed theta_bins, r_step, r_bins) */
     if (cfg.width > FZ_MAX_SIDE || cfg.height > FZ_MAX_SIDE) return 0;
+    {
+        int hw = 0, hh = 0;
+        FZ_CHECK(home_hough_size(ctx, &hw, &hh) == HOME_OK);
+        if ((long)hw * hh > FZ_MAX_HOUGH_CELLS) return 0;
+    }
 
     stride_a = stride_b = cfg.width;
     if (flags & FLAG_STRIDE) {
@@ -306,7 +325,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(hh == cfg.theta_bins && hw >= 2);
         for (i = 0; i < fa.n_pos + fa.n_neg; i++) {
             FZ_CHECK(home_keypoint_to_hough(ctx, &fa.kp[i], &col, &row) == HOME_OK);
-            FZ_CHECK(col >= 0.0f && col <= (float)hw && row >= 0.0f && row <= (float)hh);
+            FZ_CHECK(col >= 0.0f && col <= (float)hw && row >= 0.0f && row <= (float)hh * 1.0001f);
         }
         if ((flags & FLAG_RENDER) && (size_t)hw * (size_t)hh <= sizeof hough) {
             int out_stride = hw + fz_range(r, -1, 3);
@@ -326,6 +345,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             FZ_CHECK(res2.ok == 0 || res2.ok == 1);
             for (k = 0; k < 9; k++) FZ_CHECK(isfinite(res2.H[k]));
         }
+    }
+
+    if (flags & FLAG_REFINE) {
+        /* any finite H with H[8] != 0 is accepted; NaN/Inf or H[8] == 0 are refused */
+        double h0[9];
+        int k, finite = 1;
+        for (k = 0; k < 9; k++) {
+            h0[k] = (fz_u8(r) & 1) ? res.H[k] + (double)fz_float_bits(r) * 1e-3 : res.H[k];
+            finite &= isfinite(h0[k]);
+        }
+        expect = finite && fabs(h0[8]) > 1e-12 ? HOME_OK : HOME_E_CONFIG;
+        s = home_refine(ctx, img_a, stride_a, img_b, stride_b, h0, &res2);
+        FZ_CHECK(s == expect);
+        if (s == HOME_OK) FZ_CHECK(res2.ok == 0 || res2.ok == 1);
+        if (s == HOME_OK && res2.ok) for (k = 0; k < 9; k++) FZ_CHECK(isfinite(res2.H[k]));
     }
 
     /* features of another config are refused */

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Hardening (issue 7): cppcheck + gcc -fanalyzer, the worst-case stack of every public function
+# (<= 16 KiB), memcheck over the bad-input table, the fuzz corpus and the CLI, then every fuzz
+# target for FUZZ_SECONDS (60) under ASan/UBSan. Any finding fails CI.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO=sudo
+$SUDO apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev cppcheck valgrind > /dev/null
+
+echo "--- make lint"
+make lint
+echo "--- make stack"
+make stack
+echo "--- make valgrind"
+make -j2 valgrind
+echo "--- make fuzz"
+make fuzz FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
