@@ -34,6 +34,7 @@ typedef struct home__extremum {
 /* A candidate match: line (theta_a, r_a) in A against (theta_b, r_b) in B. */
 typedef struct home__match {
     float theta_a, r_a, theta_b, r_b;
+    double cos_a, sin_a, cos_b, sin_b; /* precomputed for the homography fit */
 } home__match;
 
 /* refine.c: template points of one pyramid level, structure of arrays padded to 4 lanes */
@@ -133,6 +134,7 @@ void home__quantise_descriptor(const float *samples, float scale, int reverse_ne
                                uint8_t *desc);
 
 /* match.c */
+void home__match_set(home__match *m, float theta_a, float r_a, float theta_b, float r_b);
 int home__match_features(home_context *ctx, const home_features *a, const home_features *b);
 
 /* homography.c */

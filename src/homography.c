@@ -20,15 +20,15 @@ static void line_residual(const void *user, int i, const double *g, double *e, d
 {
     const line_problem *lp = (const line_problem *)user;
     const home__match *m = &lp->matches[i];
-    double l0 = cos((double)m->theta_a), l1 = sin((double)m->theta_a);
+    double l0 = m->cos_a, l1 = m->sin_a;
     double l2 = -(double)m->r_a / lp->scale;
     double a = g[0] * l0 + g[1] * l1 + g[2] * l2;
     double b = g[3] * l0 + g[4] * l1 + g[5] * l2;
     double c = g[6] * l0 + g[7] * l1 + l2;
     double nn = a * a + b * b, n = sqrt(nn);
     if (!(n > 1e-12)) n = 1e-12, nn = n * n;
-    e[0] = lp->w_theta * (a / n - cos((double)m->theta_b));
-    e[1] = lp->w_theta * (b / n - sin((double)m->theta_b));
+    e[0] = lp->w_theta * (a / n - m->cos_b);
+    e[1] = lp->w_theta * (b / n - m->sin_b);
     e[2] = lp->w_r * (c / n + (double)m->r_b / lp->scale);
     if (jac) {
         double n3 = nn * n, l[3];

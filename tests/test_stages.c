@@ -222,10 +222,7 @@ static int exact_matches(home_context *ctx, const double *h, int n, double outli
             tb += noise * synth_gauss(rng) * HOME__PI / 480;
             rb += noise * synth_gauss(rng);
         }
-        ctx->matches[i].theta_a = (float)theta;
-        ctx->matches[i].r_a = (float)r;
-        ctx->matches[i].theta_b = (float)tb;
-        ctx->matches[i].r_b = (float)rb;
+        home__match_set(&ctx->matches[i], (float)theta, (float)r, (float)tb, (float)rb);
     }
     return n;
 }
