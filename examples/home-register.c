@@ -39,7 +39,7 @@ static void usage(FILE *f)
         "  --no-refine          keep HOME's homography (no photometric refinement)\n"
         "  --refine-levels N    refinement pyramid levels (default 3)\n"
         "  --refine-iterations N  Gauss-Newton iteration cap per level (default 10)\n"
-        "  --refine-trust PX    largest corner motion the refinement may make (default 4)\n"
+        "  --refine-trust PX    largest corner motion the refinement may make (default 6)\n"
         "  --repeat N           register N times; ms are medians, plus \"frame\": B against A's\n"
         "                       cached features (the video case)\n"
         "  --save-hough F.pgm   write A's quantised Hough image (rows theta, columns r) with\n"

@@ -83,7 +83,7 @@ typedef struct home_config {
     /* photometric refinement of HOME's H (home_refine() below); refine_levels = 0 turns it off */
     int refine_levels;        /* pyramid levels, 1..HOME_REFINE_MAX_LEVELS; default 3 */
     int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
-    float refine_trust_px;    /* largest corner motion from HOME's H accepted, px; default 4 */
+    float refine_trust_px;    /* largest corner motion from HOME's H accepted, px; default 6 */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
     home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */
@@ -160,7 +160,8 @@ enum home_refine_status {
                                      is not the last one (see home_match) */
     HOME_REFINE_FEW_POINTS,       /* too little texture: fewer than 64 usable template points */
     HOME_REFINE_NOT_CONVERGED,    /* the finest level hit refine_iterations */
-    HOME_REFINE_ILL_CONDITIONED,  /* predicted corner standard deviation above 0.5 px */
+    HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above 0.5 px (predicted, or from
+                                     two interleaved halves of the points) */
     HOME_REFINE_OUTSIDE_TRUST,    /* a corner moved more than refine_trust_px from HOME's H */
     HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
     HOME_REFINE_LOW_CORRELATION   /* HOME failed and the refinement cannot vouch (rule below) */

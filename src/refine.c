@@ -9,13 +9,15 @@
  * occluders and moving objects lose their pull. Every level has a fixed iteration cap.
  *
  * Template points: per level, the pixel of largest |gx| + |gy| in each block (4x4 at full
- * resolution, 2x2 at half, 1x1 below) whose gradient clears a noise floor, strongest first up
- * to HOME_REFINE_MAX_POINTS >> level. Flat regions contribute nothing to LK but cost time.
+ * resolution, 2x2, 1x1) whose score clears a camera-noise floor, strongest first up to
+ * HOME_REFINE_MAX_POINTS >> level. Flat regions contribute nothing to LK but time.
  *
  * Safeguards (result.refine_status): the refined H replaces HOME's only if the finest level
- * converged within its cap, the robust photometric error over the points both warps keep
- * is lower, the corners moved at most refine_trust_px, and the estimate is well conditioned
- * (predicted corner standard deviation). Otherwise HOME's H stays.
+ * converged within its cap, the estimate is well conditioned (the corners' standard deviation
+ * predicted by the Fisher information, and the disagreement of two interleaved halves of the
+ * points, which also sees noise in the template's own gradients, both under 0.5 px), no corner
+ * moved more than refine_trust_px, and the robust photometric error over the points both
+ * warps keep went down. Otherwise HOME's H stays. Noise-only templates never converge.
  *
  * Coordinates: normalised u = (x - cx) / f, v = (y - cy) / f with cx, cy the image centre and
  * f half the longer side, so the 8 parameters are O(1) at every level. Level l pixel x_l sits at
@@ -31,18 +33,17 @@
 #define SIGMA_FLOOR 0.5     /* grey levels: the residual scale never collapses below this */
 #define MIN_POINTS 64       /* fewer usable template points at a level: textureless, decline */
 #define STEP_EPS_PX 0.01    /* convergence: largest corner update, full-resolution px */
-#define MAX_CORNER_STD_PX 0.5 /* predicted corner standard deviation above this: ill conditioned */
+#define MAX_CORNER_STD_PX 0.5 /* corner standard deviation (Fisher or split-half) above this:
+                                 ill conditioned */
 
-/* Noise floor of the selection score |gx| + |gy| (2x central differences, grey levels) at each
- * level: above camera noise of sigma ~3 at full resolution, halved per level as 2x2 averaging
- * halves the noise. */
-static int score_floor(int level)
-{
-    static const int floor_at[HOME_REFINE_MAX_LEVELS > 3 ? HOME_REFINE_MAX_LEVELS : 3] = {24, 12, 8};
-    return level < 3 ? floor_at[level] : 6;
-}
+/* Block side of the point selection per level: 4x4 at full resolution, 2x2, then 1x1. */
+static int block_side(int level) { return level == 0 ? 4 : level == 1 ? 2 : 1; }
 
-static int block_side(int level) { return level >= 2 ? 1 : 4 >> level; }
+/* Selection floor of the score |gx| + |gy| (2x central differences of the blurred level): above
+ * the best of a block of pure camera noise up to sigma ~3 grey levels (the blur and each 2x2
+ * average shrink the noise's score), so flat regions give no points and a textureless frame
+ * gives too few to refine. */
+static int score_floor(int level) { return level == 0 ? 8 : level == 1 ? 4 : 3; }
 
 static int level_capacity(int level)
 {
@@ -58,7 +59,7 @@ void home__refine_defaults(home_config *cfg)
 {
     cfg->refine_levels = HOME_REFINE_MAX_LEVELS < 3 ? HOME_REFINE_MAX_LEVELS : 3;
     cfg->refine_iterations = 10;
-    cfg->refine_trust_px = 4.0f;
+    cfg->refine_trust_px = 6.0f;
 }
 
 int home__refine_validate(const home_config *cfg)
@@ -166,10 +167,12 @@ static uint32_t hash_bytes(const uint8_t *p, size_t n)
 static void select_points(const home__refine_kernels *rk, const uint8_t *img, int w, int h,
                           int level, int16_t *keys, uint16_t *cells, home__refine_points *out)
 {
-    const int b = block_side(level), floor_score = score_floor(level);
-    const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
-    int hist[256], bx, by, x, y, dy, bin, quota, n = 0, cut, above;
+    const int b = block_side(level);
+    const int bw = (w + b - 1) / b, bh = (h + b - 1) / b, n_blocks = bw * bh;
+    int hist[256], bx, by, x, y, dy, bin, quota, n = 0, cut, above, i, j;
+    const int floor_bin = score_floor(level) / 2;
     memset(hist, 0, sizeof hist);
+    /* pass 1: best key (score << 4 | offset) of every block, histogram of score bins */
     for (by = 0; by < bh; by++) {
         int rows = 0;
         for (dy = 0; dy < b; dy++) {
@@ -181,40 +184,38 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
             int best = 0;
             if (rows)
                 for (x = bx * b; x < bx * b + b && x < w; x++) best = keys[x] > best ? keys[x] : best;
-            if ((best >> 4) >= floor_score) {
-                bin = (best >> 6) > 255 ? 255 : best >> 6;
-                hist[bin]++;
-                cells[by * bw + bx] = (uint16_t)(0x8000 | bin << 4 | (best & 15));
-            } else {
-                cells[by * bw + bx] = 0;
-            }
+            cells[by * bw + bx] = (uint16_t)best;
+            hist[best >> 5 > 255 ? 255 : best >> 5]++;   /* bin = score / 2 */
         }
     }
-    /* lowest bin that still fits, and how many of that bin are allowed */
+    /* the lowest bin that still fits the capacity, not below the floor */
     above = 0;
-    for (cut = 255; cut > 0; cut--) {
+    for (cut = 255; cut > floor_bin; cut--) {
         if (above + hist[cut] >= out->capacity) break;
         above += hist[cut];
     }
     quota = out->capacity - above;
-    for (by = 0; by < bh; by++) {
-        for (bx = 0; bx < bw; bx++) {
-            unsigned c = cells[by * bw + bx];
-            const uint8_t *p;
-            if (!(c & 0x8000u)) continue;
-            bin = (int)((c >> 4) & 0xffu);
-            if (bin < cut || (bin == cut && quota <= 0)) continue;
-            if (bin == cut) quota--;
-            x = bx * b + (int)(c & 15u) % b;
-            y = by * b + (int)(c & 15u) / b;
-            p = img + (ptrdiff_t)y * w + x;
-            out->x[n] = (int16_t)x;
-            out->y[n] = (int16_t)y;
-            out->t[n] = (int16_t)p[0];
-            out->gx[n] = (int16_t)(p[1] - p[-1]);
-            out->gy[n] = (int16_t)(p[w] - p[-w]);
-            n++;
+    /* pass 2: every block above the cut bin, and of the cut bin an evenly spread quota (the
+     * j-th of its members when j * quota / count steps), so no image region is favoured */
+    for (i = 0, j = 0; i < n_blocks; i++) {
+        const int key = cells[i];
+        const uint8_t *p;
+        bin = key >> 5 > 255 ? 255 : key >> 5;
+        if (bin < cut) continue;
+        if (bin == cut) {
+            long before = (long)j * quota / hist[cut], after = (long)(j + 1) * quota / hist[cut];
+            j++;
+            if (after == before) continue;
         }
+        x = (i % bw) * b + (key & 15) % b;
+        y = (i / bw) * b + (key & 15) / b;
+        p = img + (ptrdiff_t)y * w + x;
+        out->x[n] = (int16_t)x;
+        out->y[n] = (int16_t)y;
+        out->t[n] = (int16_t)p[0];
+        out->gx[n] = (int16_t)(p[1] - p[-1]);
+        out->gy[n] = (int16_t)(p[w] - p[-w]);
+        n++;
     }
     out->n = n;
     /* pad to whole lanes with inert points (zero gradient, zero weight at match time) */
@@ -256,6 +257,7 @@ typedef struct solver {
     double sigma;                       /* residual scale of the last iteration */
     double jtj[64];                     /* last weighted normal matrix (normalised units) */
     double resid_var;                   /* weighted residual variance of the last iteration */
+    double split_px;                    /* split-half disagreement of the last finest step */
     float *img_b, *img_b2, *res, *wt;   /* per-point scratch */
 } solver;
 
@@ -418,6 +420,23 @@ static double corner_step_px(const solver *s, const double *dp)
     return worst;
 }
 
+/* Normal equations (J^T W J, J^T W r) in normalised units from the lanes in lane_mask. */
+static void normal_equations(const float *acc, unsigned lane_mask, double k, double *a, double *g)
+{
+    int p, q, j, l;
+    for (p = 0, j = 0; p < 8; p++) {
+        double v;
+        for (q = p; q < 8; q++, j++) {
+            for (l = 0, v = 0.0; l < LANES; l++)
+                if (lane_mask >> l & 1) v += (double)acc[j * LANES + l];
+            a[p * 8 + q] = a[q * 8 + p] = v * k * k;
+        }
+        for (l = 0, v = 0.0; l < LANES; l++)
+            if (lane_mask >> l & 1) v += (double)acc[(36 + p) * LANES + l];
+        g[p] = v * k;
+    }
+}
+
 /* One IRLS Gauss-Newton step at a level. Returns 0 when too few points stay usable or the
  * system is singular; *step_px gets the corner motion of the update. */
 static int iterate(solver *s, int level, double *step_px)
@@ -429,7 +448,7 @@ static int iterate(solver *s, int level, double *step_px)
     const double k = s->f / (2.0 * sc);  /* template gradient: 2x central difference per level px */
     float m[9], aff[3], acc[N_ACC * LANES];
     double a[64], g[8], dp[9], hd[9], hdi[9], t[9], sum_w = 0, sum_wr2 = 0;
-    int i, j, p, q, valid;
+    int i, p, valid;
 
     level_matrix(s, s->hn, level, m);
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
@@ -441,18 +460,22 @@ static int iterate(solver *s, int level, double *step_px)
     aff[1] = (float)((o - s->cx) / s->f);
     aff[2] = (float)((o - s->cy) / s->f);
     st->rk->accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff, acc);
-    for (p = 0, j = 0; p < 8; p++) {
-        for (q = p; q < 8; q++, j++) {
-            const float *l = acc + j * LANES;
-            double v = ((double)l[0] + (double)l[1]) + ((double)l[2] + (double)l[3]);
-            a[p * 8 + q] = a[q * 8 + p] = v * k * k;
-        }
-        {
-            const float *l = acc + (36 + p) * LANES;
-            g[p] = (((double)l[0] + (double)l[1]) + ((double)l[2] + (double)l[3])) * k;
+    normal_equations(acc, 0xf, k, a, g);
+    memcpy(s->jtj, a, sizeof a);
+    if (level == 0) {
+        /* split-half check: the steps of the even and the odd lanes (interleaved halves of the
+         * points) from the same estimate agree when the points carry signal and scatter when
+         * they carry template noise, which the Fisher covariance cannot see */
+        double ae[64], ge[8], ao[64], go[8];
+        normal_equations(acc, 0x5, k, ae, ge);
+        normal_equations(acc, 0xa, k, ao, go);
+        if (home__solve_spd8(ae, ge) && home__solve_spd8(ao, go)) {
+            for (p = 0; p < 8; p++) ge[p] -= go[p];
+            s->split_px = 0.5 * corner_step_px(s, ge);
+        } else {
+            s->split_px = INFINITY;
         }
     }
-    memcpy(s->jtj, a, sizeof a);
     for (i = 0; i < tp->n; i++) {
         sum_w += s->wt[i];
         sum_wr2 += (double)s->wt[i] * s->res[i] * s->res[i];
@@ -591,7 +614,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     result->refine_iterations = iterations;
     if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return; }
     to_pixels(&s, s.hn, h1);
-    if (corner_std_px(&s) > MAX_CORNER_STD_PX) {
+    if (corner_std_px(&s) > MAX_CORNER_STD_PX || !(s.split_px <= MAX_CORNER_STD_PX)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return;
     }
