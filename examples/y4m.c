@@ -48,11 +48,14 @@ int y4m_read_header(FILE *f, y4m_info *info, char *err, size_t err_size)
             if (tok[0] == 'W') info->width = (int)v; else info->height = (int)v;
             break;
         case 'C':
-            if (!strncmp(tok, "C420", 4)) info->chroma = 420;
+            /* 8-bit 4:2:0 of any chroma siting; C420p10 and the like are high bit depth */
+            if (!strcmp(tok, "C420") || !strcmp(tok, "C420jpeg") || !strcmp(tok, "C420paldv") ||
+                !strcmp(tok, "C420mpeg2"))
+                info->chroma = 420;
             else if (!strcmp(tok, "C422")) info->chroma = 422;
             else if (!strcmp(tok, "Cmono")) info->chroma = 0;
             else {
-                snprintf(err, err_size, "unsupported Y4M colour space '%s' (420*, 422, mono)", tok);
+                snprintf(err, err_size, "unsupported Y4M colour space '%s' (8-bit C420*, C422, Cmono)", tok);
                 return -1;
             }
             snprintf(info->colour_tag, sizeof info->colour_tag, "%s", tok);
