@@ -36,6 +36,8 @@ TEST_BINS := $(BUILD)/bin/home-tests
 all: $(LIB) $(BINS)
 
 -include $(sort $(wildcard mk/*.mk))
+# prerequisites are expanded when read: name the BINS that mk/*.mk added
+all: $(BINS)
 
 $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_internal.h port/kernels.h
 	@mkdir -p $(dir $@)
