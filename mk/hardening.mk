@@ -9,15 +9,15 @@
 HARD_TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/test_bad_input*.c))
 HARD_TESTS := $(BUILD)/bin/home-hardening-tests
 FUZZ_REPLAY := $(BUILD)/bin/home-fuzz-replay
-# y4m joins once the Y4M reader exists
-FUZZ_TARGETS := api pgm $(if $(and $(wildcard examples/y4m.c),$(wildcard tests/fuzz/fuzz_y4m.c)),y4m)
+FUZZ_TARGETS := api pgm y4m
 FUZZ_REPLAY_OBJ := $(foreach t,$(FUZZ_TARGETS),$(BUILD)/obj/fuzz-replay/fuzz_$(t).o)
+FUZZ_SUPPORT := $(SUPPORT_OBJ) $(BUILD)/obj/examples/y4m.o
 BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
 TEST_BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
 # `all` is declared before mk/*.mk are included, so BINS added here must be named explicitly
 all: $(HARD_TESTS) $(FUZZ_REPLAY)
 
-$(HARD_TESTS): $(HARD_TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
+$(HARD_TESTS): $(HARD_TEST_OBJ) $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) -pthread
 
@@ -30,7 +30,7 @@ $(BUILD)/obj/fuzz-replay/replay.o: tests/fuzz/replay.c $(MAKEFILE_LIST)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) '-DFUZZ_TARGETS(X)=$(FUZZ_TARGET_LIST)' -c $< -o $@
 
-$(FUZZ_REPLAY): $(BUILD)/obj/fuzz-replay/replay.o $(FUZZ_REPLAY_OBJ) $(SUPPORT_OBJ) $(LIB)
+$(FUZZ_REPLAY): $(BUILD)/obj/fuzz-replay/replay.o $(FUZZ_REPLAY_OBJ) $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
@@ -49,9 +49,9 @@ fuzz-build:
 
 fuzz-bins: $(foreach t,$(FUZZ_TARGETS),$(BUILD)/fuzz/fuzz_$(t))
 
-$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(SUPPORT_OBJ) $(LIB)
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) -fsanitize=fuzzer $< $(SUPPORT_OBJ) $(LIB) -o $@ $(LDFLAGS_APP)
+	$(CC) $(CFLAGS_APP) -fsanitize=fuzzer $< $(FUZZ_SUPPORT) $(LIB) -o $@ $(LDFLAGS_APP)
 
 # FUZZ_SECONDS per target, one after the other (FUZZ_TARGET=api picks one).
 fuzz: fuzz-build

@@ -3,11 +3,13 @@
  * on a fresh fixture (a valid 64x64 config, context, images and extracted features), so each row
  * shows a single thing wrong. Also the test runner of home-hardening-tests: `NAME...` runs a
  * subset, `--list` prints the table. */
+#define _POSIX_C_SOURCE 200809L
 #include "test.h"
 #include "test_bad_input.h"
 #include "home.h"
 #include "pgm.h"
 #include "synth.h"
+#include "y4m.h"
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -85,6 +87,31 @@ static int pgm(const char *text, size_t size)
 }
 #define PGM(literal) pgm(literal, sizeof literal - 1)
 
+/* Y4M reader (examples/y4m.c): the header's status, or else the last frame read's (1 a frame,
+ * 0 a clean end, -1 malformed or truncated); refusals must say why. */
+static int y4m(const char *text, size_t size, int frames)
+{
+    static char copy[256];
+    static uint8_t frame[4096];
+    char err[160] = "";
+    y4m_info info;
+    int s = -1, k;
+    FILE *f;
+    memcpy(copy, text, size);
+    if (!(f = fmemopen(copy, size ? size : 1, "rb"))) return 99;
+    if (!size) (void)getc(f); /* an empty stream: consume the placeholder byte */
+    s = y4m_read_header(f, &info, err, sizeof err);
+    for (k = 0; s == 0 && k < frames; k++) {
+        int got;
+        if (y4m_frame_bytes(&info) > sizeof frame) { s = 99; break; }
+        got = y4m_read_frame(f, &info, frame, err, sizeof err);
+        if (got <= 0 || k == frames - 1) { s = got; break; }
+    }
+    fclose(f);
+    return (s < 0 && err[0] == '\0') ? 98 : s;
+}
+#define Y4M(literal, frames) y4m(literal, sizeof literal - 1, frames)
+
 /* name, expected value, expression; the comment column of the README's table */
 #define BAD_INPUTS(X) \
     /* configuration */ \
@@ -145,6 +172,7 @@ static int pgm(const char *text, size_t size)
     X(extract_stride_below_width, HOME_E_STRIDE, home_extract(ctx, img_a, W - 1, &fa)) \
     X(extract_stride_zero, HOME_E_STRIDE, home_extract(ctx, img_a, 0, &fa)) \
     X(extract_stride_negative, HOME_E_STRIDE, home_extract(ctx, img_a + (H - 1) * W, -W, &fa)) \
+    X(extract_stride_overflows, HOME_E_STRIDE, home_extract(ctx, img_a, PTRDIFF_MAX / 2, &fa)) \
     X(extract_uninitialised_context, HOME_E_STATE, home_extract((home_context *)(void *)junk.bytes, img_a, W, &fa)) \
     X(extract_context_overwritten, HOME_E_STATE, (memset(arena.bytes, 0, 64), home_extract(ctx, img_a, W, &fa))) \
     /* matching: stages out of order, corrupted or foreign features */ \
@@ -190,7 +218,26 @@ static int pgm(const char *text, size_t size)
     X(pgm_no_separator_after_maxval, -1, PGM("P5\n2 2\n255")) \
     X(pgm_truncated_raster, -1, PGM("P5\n2 2\n255\n\1\2\3")) \
     X(pgm_with_comments_accepted, 0, PGM("P5 # c\n#only comment\n2 2 255\n\1\2\3\4")) \
-    X(pgm_trailing_bytes_accepted, 0, PGM("P5\n2 1\n255\n\1\2\3"))
+    X(pgm_trailing_bytes_accepted, 0, PGM("P5\n2 1\n255\n\1\2\3")) \
+    /* Y4M reader (examples/y4m.c): refusals return -1 with a reason; home-stab exits 2 (header) \
+     * or 1 (a bad frame after good ones) */ \
+    X(y4m_empty, -1, Y4M("", 0)) \
+    X(y4m_not_y4m, -1, Y4M("RIFF\x24\0\0\0WAVEfmt \n", 0)) \
+    X(y4m_no_size, -1, Y4M("YUV4MPEG2 F30:1 C420\n", 0)) \
+    X(y4m_width_zero, -1, Y4M("YUV4MPEG2 W0 H2\n", 0)) \
+    X(y4m_width_negative, -1, Y4M("YUV4MPEG2 W-2 H2\n", 0)) \
+    X(y4m_absurd_size, -1, Y4M("YUV4MPEG2 W99999 H99999\n", 0)) \
+    X(y4m_size_not_a_number, -1, Y4M("YUV4MPEG2 W2x H2\n", 0)) \
+    X(y4m_444_unsupported, -1, Y4M("YUV4MPEG2 W2 H2 C444\n", 0)) \
+    X(y4m_10_bit_unsupported, -1, Y4M("YUV4MPEG2 W2 H2 C420p10\n", 0)) \
+    X(y4m_16_bit_mono_unsupported, -1, Y4M("YUV4MPEG2 W2 H2 Cmono16\n", 0)) \
+    X(y4m_odd_size_420, -1, Y4M("YUV4MPEG2 W3 H3 C420\n", 0)) \
+    X(y4m_no_newline, -1, Y4M("YUV4MPEG2 W2 H2", 0)) \
+    X(y4m_bad_frame_marker, -1, Y4M("YUV4MPEG2 W2 H2 Cmono\nFRAMX\n\1\2\3\4", 1)) \
+    X(y4m_truncated_frame, -1, Y4M("YUV4MPEG2 W2 H2 C420jpeg\nFRAME\n\1\2\3", 1)) \
+    X(y4m_truncated_second_frame, -1, Y4M("YUV4MPEG2 W2 H2 C420\nFRAME\n\1\2\3\4\5\6FRAME\n\1", 2)) \
+    X(y4m_420_frame_accepted, 1, Y4M("YUV4MPEG2 W2 H2 F30:1 Ip A1:1 C420mpeg2 XYSCSS=420MPEG2\nFRAME\n\1\2\3\4\5\6", 1)) \
+    X(y4m_clean_end_accepted, 0, Y4M("YUV4MPEG2 W2 H2 C422\nFRAME\n\1\2\3\4\5\6\7\10", 2))
 
 #define DEFINE_ROW(name, expect, expr) static int row_##name(void) { return (expr); }
 BAD_INPUTS(DEFINE_ROW)

@@ -65,6 +65,25 @@ def main():
     for name, data in pgm_seeds.items():
         (pgm / f"seed-{name}").write_bytes(data)
 
+    y4m = ROOT / "y4m"
+    y4m.mkdir(parents=True, exist_ok=True)
+    frame = lambda n: b"FRAME\n" + bytes(rng.randrange(256) for _ in range(n))
+    y4m_seeds = {
+        "420-2frames": b"YUV4MPEG2 W8 H4 F30:1 Ip A1:1 C420jpeg\n" + frame(48) + frame(48),
+        "422": b"YUV4MPEG2 W4 H2 C422\n" + frame(16),
+        "mono-params": b"YUV4MPEG2 W3 H3 F25:1 XYSCSS=420JPEG Cmono\n" + frame(9),
+        "frame-params": b"YUV4MPEG2 W2 H2\nFRAME Ixyz\n" + bytes(6),
+        "truncated": b"YUV4MPEG2 W16 H16 C420\n" + frame(100),
+        "bad-marker": b"YUV4MPEG2 W2 H2 C420\nFRAMX\n" + bytes(6),
+        "444": b"YUV4MPEG2 W2 H2 C444\n" + frame(12),
+        "10bit": b"YUV4MPEG2 W2 H2 C420p10\n" + frame(12),
+        "huge": b"YUV4MPEG2 W99999 H99999\n",
+        "odd-420": b"YUV4MPEG2 W3 H3 C420\n" + frame(14),
+        "no-size": b"YUV4MPEG2 F30:1\n",
+    }
+    for name, data in y4m_seeds.items():
+        (y4m / f"seed-{name}").write_bytes(data)
+
 
 if __name__ == "__main__":
     main()
