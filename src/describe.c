@@ -5,32 +5,37 @@
 #include "home_internal.h"
 #include <math.h>
 
-/* Bilinear J at (row t relative to rows[0], column r); zero beyond the r axis. */
-static float sample(const float *const *rows, float t, float r, int r_bins)
+/* J along the r axis at r0, r0 + 1, ..., r0 + 31 on the theta position t (relative to rows[0]),
+ * bilinear; zero beyond the r axis. */
+static void radial_profile(const float *const *rows, float t, float r0, int r_bins, float *out)
 {
-    int t0 = (int)floorf(t), r0 = (int)floorf(r);
-    float ft = t - (float)t0, fr = r - (float)r0;
-    float a0 = 0.0f, a1 = 0.0f, b0 = 0.0f, b1 = 0.0f;
+    int t0 = (int)floorf(t), i0 = (int)floorf(r0), m;
+    float ft = t - (float)t0, fr = r0 - (float)i0;
+    const float *a, *b;
     if (t0 < 0) { t0 = 0; ft = 0.0f; }
     if (t0 > HOME__DESC_ROWS - 2) { t0 = HOME__DESC_ROWS - 2; ft = 1.0f; }
-    if (r0 >= 0 && r0 < r_bins) { a0 = rows[t0][r0]; b0 = rows[t0 + 1][r0]; }
-    if (r0 + 1 >= 0 && r0 + 1 < r_bins) { a1 = rows[t0][r0 + 1]; b1 = rows[t0 + 1][r0 + 1]; }
-    return (1.0f - ft) * ((1.0f - fr) * a0 + fr * a1) + ft * ((1.0f - fr) * b0 + fr * b1);
+    a = rows[t0];
+    b = rows[t0 + 1];
+    for (m = 0; m < 2 * HOME_DESC_LEN; m++) {
+        int i = i0 + m;
+        float v0 = 0.0f, v1 = 0.0f;
+        if (i >= 0 && i < r_bins) v0 = a[i] + ft * (b[i] - a[i]);
+        if (i + 1 >= 0 && i + 1 < r_bins) v1 = a[i + 1] + ft * (b[i + 1] - a[i + 1]);
+        out[m] = v0 + fr * (v1 - v0);
+    }
 }
 
-/* rows[0..4] are smoothed rows centre-2 .. centre+2. */
+/* rows[0..4] are smoothed rows centre-2 .. centre+2. The 2x32 patch centred on the keypoint
+ * has its rows at theta +- 0.5 and its columns at r - 15.5 .. r + 15.5. */
 void home__describe_samples(const float *const *rows, int centre, int r_bins, float theta_bin,
                             float r_bin, float *samples)
 {
-    float t = theta_bin - (float)(centre - 2);
+    float t = theta_bin - (float)(centre - 2), lo[2 * HOME_DESC_LEN], hi[2 * HOME_DESC_LEN];
     int k;
-    for (k = 0; k < HOME_DESC_LEN; k++) {
-        float r = r_bin - 16.0f + 2.0f * (float)k;
-        samples[k] = 0.25f * (sample(rows, t - 0.5f, r + 0.5f, r_bins) +
-                              sample(rows, t - 0.5f, r + 1.5f, r_bins) +
-                              sample(rows, t + 0.5f, r + 0.5f, r_bins) +
-                              sample(rows, t + 0.5f, r + 1.5f, r_bins));
-    }
+    radial_profile(rows, t - 0.5f, r_bin - 15.5f, r_bins, lo);
+    radial_profile(rows, t + 0.5f, r_bin - 15.5f, r_bins, hi);
+    for (k = 0; k < HOME_DESC_LEN; k++)
+        samples[k] = 0.25f * (lo[2 * k] + lo[2 * k + 1] + hi[2 * k] + hi[2 * k + 1]);
 }
 
 /* uint8 quantisation 128 + v*scale. The alternate form of a keypoint near the theta wrap is
