@@ -93,15 +93,19 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
     int p, v, j, s_min, s_max, j0, n, n_blocks, blk, i;
 
     for (p = 0; p < rows; p++) {
-        double pc = (flip ? rows - 1 - p : p) - centre;
-        ctx->shift[p] = (int16_t)floor(t * pc + 0.5);
+        double x = t * ((flip ? rows - 1 - p : p) - centre) + 0.5;
+        int k = (int)x;
+        ctx->shift[p] = (int16_t)(k > x ? k - 1 : k); /* floor without a libm call */
     }
     s_min = ctx->shift[0];
     s_max = ctx->shift[rows - 1];
+    /* first_row[v - s_min]: first row whose shift is >= v, for v in [s_min, s_max + 1] */
+    ctx->first_row[0] = 0;
     for (p = 0, v = s_min + 1; v <= s_max; v++) {
         while (ctx->shift[p] < v) p++;
         ctx->first_row[v - s_min] = p;
     }
+    ctx->first_row[s_max - s_min + 1] = rows;
     /* intercepts of every line touching the image, plus one on each side for S(j +- 1) */
     j0 = -s_max - 1;
     n = cols - s_min - j0 + 1;
@@ -120,19 +124,25 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
         left[p + 1] = left[p] + row[0];
         right[p + 1] = right[p] + row[cols - 1];
     }
-    for (i = 0; i < n; i++) {
-        int entry, after;
-        j = j0 + i;
-        entry = first_row_at(ctx, -j, s_min, s_max, rows);   /* rows before: left of the image */
-        after = first_row_at(ctx, cols - j, s_min, s_max, rows); /* rows from here: right of it */
-        sum[i] += left[entry] + right[rows] - right[after];
-        if (entry < after) {
-            int first_value = base[(ptrdiff_t)entry * stride + j + ctx->shift[entry]];
-            int last_value = base[(ptrdiff_t)(after - 1) * stride + j + ctx->shift[after - 1]];
-            /* [I] between the line's ends, in increasing original row order */
-            line[i] = (float)(2.0 * b * (flip ? first_value - last_value : last_value - first_value));
-        } else {
-            line[i] = 0.0f;
+    {
+        const int32_t *fr = ctx->first_row, right_total = right[rows];
+        const int span = s_max - s_min + 1;
+        const double end_scale = flip ? -2.0 * b : 2.0 * b; /* [I] in original row order */
+        for (i = 0; i < n; i++) {
+            int v_entry, v_after, entry, after;
+            j = j0 + i;
+            v_entry = -j - s_min;                   /* rows before the entry: left of the image */
+            v_after = cols - j - s_min;             /* rows from `after` on: right of it */
+            entry = fr[v_entry < 0 ? 0 : v_entry > span ? span : v_entry];
+            after = fr[v_after > span ? span : v_after];
+            sum[i] += left[entry] + right_total - right[after];
+            if (entry < after) {
+                int first_value = base[(ptrdiff_t)entry * stride + j + ctx->shift[entry]];
+                int last_value = base[(ptrdiff_t)(after - 1) * stride + j + ctx->shift[after - 1]];
+                line[i] = (float)(end_scale * (last_value - first_value));
+            } else {
+                line[i] = 0.0f;
+            }
         }
     }
     /* J on the intercept grid (in place over the end terms), then resampled to the r axis */
@@ -146,13 +156,28 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
         /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0 */
         const double dj = ctx->cfg.r_step / a;
         const double jf0 = -0.5 * (ctx->r_bins - 1) * dj + 0.5 * (cols - 1) - j0;
+        /* bins whose jf falls in [0, n - 1): a contiguous range (|dj| > 0), zero elsewhere */
+        double lo = dj > 0 ? -jf0 / dj : (n - 1 - jf0) / dj;
+        double hi = dj > 0 ? (n - 1 - jf0) / dj : -jf0 / dj;
+        int i_lo = lo < 0 ? 0 : (int)lo, i_hi = hi >= ctx->r_bins ? ctx->r_bins : (int)hi + 1;
         for (i = 0; i < ctx->r_bins; i++) {
             double jf = jf0 + i * dj, f;
             int k;
+            if (i == i_lo) {                   /* the interior, without per-bin range tests */
+                for (; i < i_hi; i++) {
+                    jf = jf0 + i * dj;
+                    if (!(jf >= 0.0) || jf >= (double)(n - 1)) break;
+                    k = (int)jf;
+                    f = jf - k;
+                    out[i] = (float)(line[k] + f * (line[k + 1] - line[k]));
+                }
+                if (i >= ctx->r_bins) break;
+                jf = jf0 + i * dj;
+            }
             if (!(jf >= 0.0) || jf >= (double)(n - 1)) { out[i] = 0.0f; continue; }
             k = (int)jf; /* jf >= 0: truncation is floor */
             f = jf - k;
-            out[i] = (float)((1.0 - f) * line[k] + f * line[k + 1]);
+            out[i] = (float)(line[k] + f * (line[k + 1] - line[k]));
         }
     }
 }
