@@ -86,6 +86,9 @@ typedef struct home_config {
     float refine_trust_px;    /* largest corner motion from HOME's H accepted, px; default 6 */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
+    int hough_downscale;      /* 1: Hough transform of the image itself; 2: of its 2x2-box
+                                 downscaled copy (FAST only): ~4x less Hough work, for video on
+                                 small cores; r bins are then 2*r_step px of the full image */
     home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */
     void *clock_user;
 } home_config;

@@ -40,6 +40,7 @@ int home_default_config(home_config *cfg, int width, int height)
     home__refine_defaults(cfg);
     cfg->simd = HOME_SIMD_AUTO;
     cfg->hough_method = HOME_HOUGH_FAST;
+    cfg->hough_downscale = 1;
 #ifndef HOME_NO_GETENV
     {
         const char *env = getenv("HOME_SIMD");
@@ -68,9 +69,19 @@ static int r_bins_for(int width, int height, float r_step)
     return 2 * ((int)ceil(half_diag / r_step) + 1);
 }
 
+/* Size of the image the Hough transform sees (after hough_downscale). */
+void home__hough_size(const home_config *cfg, int *width, int *height)
+{
+    int ds = cfg->hough_downscale == 2 ? 2 : 1;
+    *width = cfg->width / ds;
+    *height = cfg->height / ds;
+}
+
 int home__r_bins(const home_config *cfg)
 {
-    return cfg->r_bins ? cfg->r_bins : r_bins_for(cfg->width, cfg->height, cfg->r_step);
+    int w, h;
+    home__hough_size(cfg, &w, &h);
+    return cfg->r_bins ? cfg->r_bins : r_bins_for(w, h, cfg->r_step);
 }
 
 int home_validate_config(const home_config *cfg)
@@ -85,7 +96,9 @@ int home_validate_config(const home_config *cfg)
     if (cfg->r_bins != 0) {
         /* an explicit r axis must be even and cover the image diagonal */
         if (cfg->r_bins < 0 || (cfg->r_bins & 1) ||
-            cfg->r_bins < r_bins_for(cfg->width, cfg->height, cfg->r_step) ||
+            cfg->r_bins < home__r_bins(&(home_config){.width = cfg->width, .height = cfg->height,
+                                         .r_step = cfg->r_step,
+                                         .hough_downscale = cfg->hough_downscale}) ||
             cfg->r_bins > 4 * HOME_MAX_SIDE)
             return HOME_E_CONFIG;
     }
@@ -104,6 +117,10 @@ int home_validate_config(const home_config *cfg)
     if (!home__kernels_for(cfg->simd)) return HOME_E_CONFIG; /* unknown or not compiled in */
     if (cfg->hough_method != HOME_HOUGH_FAST && cfg->hough_method != HOME_HOUGH_EXACT)
         return HOME_E_CONFIG;
+    if (cfg->hough_downscale != 1 &&
+        (cfg->hough_downscale != 2 || cfg->hough_method != HOME_HOUGH_FAST ||
+         cfg->width / 2 < HOME_MIN_SIDE || cfg->height / 2 < HOME_MIN_SIDE))
+        return HOME_E_CONFIG;
     return HOME_OK;
 }
 
@@ -115,7 +132,8 @@ uint32_t home__config_id(const home_config *cfg)
     float ffields[2];
     const unsigned char *p;
     size_t i;
-    fields[0] = cfg->width; fields[1] = cfg->height; fields[2] = cfg->theta_bins;
+    fields[0] = cfg->width + (cfg->hough_downscale == 2 ? 1 << 20 : 0);
+    fields[1] = cfg->height; fields[2] = cfg->theta_bins;
     fields[3] = home__r_bins(cfg); fields[4] = cfg->keypoints_per_sign; fields[5] = cfg->wrap_band;
     ffields[0] = cfg->r_step; ffields[1] = cfg->smooth_sigma;
     p = (const unsigned char *)fields;
@@ -150,7 +168,12 @@ static void plan(const home_config *cfg, layout *l)
     size_t radius = (size_t)ceil(3.0 * cfg->smooth_sigma);
     /* every query keypoint, in primary and (near the wrap) alternate form, yields <= 1 match */
     l->max_matches = 4 * cfg->keypoints_per_sign;
-    size_t w = (size_t)cfg->width, h = (size_t)cfg->height, longest = w > h ? w : h;
+    int hough_w, hough_h;
+    size_t w, h, longest;
+    home__hough_size(cfg, &hough_w, &hough_h);
+    w = (size_t)hough_w;
+    h = (size_t)hough_h;
+    longest = w > h ? w : h;
     /* intercepts of one theta row: the other side + both shear extents + derivative + a block */
     size_t intercepts = w + h + 8 + 2 * HOME__RADON_BLOCK;
     l->ctx = take(&cur, sizeof(home_context));
@@ -215,6 +238,12 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
     memset(ctx, 0, sizeof *ctx);
     ctx->cfg = *cfg;
     ctx->r_bins = home__r_bins(cfg);
+    home__hough_size(cfg, &ctx->hough_w, &ctx->hough_h);
+    ctx->hough_scale = cfg->hough_downscale == 2 ? 2 : 1;
+    /* the Hough image covers full-image columns [0, scale * hough_w): its centre sits at
+     * (scale * hough_w - 1) / 2, i.e. this far from the full image's centre */
+    ctx->hough_dx = 0.5 * (ctx->hough_scale * ctx->hough_w - cfg->width);
+    ctx->hough_dy = 0.5 * (ctx->hough_scale * ctx->hough_h - cfg->height);
     ctx->cfg.r_bins = ctx->r_bins;
     ctx->config_id = home__config_id(&ctx->cfg);
     ctx->smooth_radius = home__gauss_taps(cfg->smooth_sigma, ctx->smooth_taps);

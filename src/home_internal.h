@@ -63,6 +63,10 @@ struct home_context {
     home_config cfg;
     uint32_t config_id;
     int r_bins;
+    int hough_w, hough_h;             /* image size the Hough transform sees */
+    int hough_scale;                  /* hough_downscale: full-image px per Hough-image px */
+    double hough_dx, hough_dy;        /* full-image centred coordinates of the Hough image's
+                                         centre (non-zero for odd sizes when downscaled) */
     int smooth_radius;
     float smooth_taps[2 * HOME__MAX_SMOOTH_RADIUS + 1];
     const home__kernels *kernels;     /* SIMD backend */
@@ -93,6 +97,7 @@ struct home_context {
 /* arena.c */
 uint32_t home__config_id(const home_config *cfg);
 int home__r_bins(const home_config *cfg);
+void home__hough_size(const home_config *cfg, int *width, int *height);
 int home__check_image(const home_context *ctx, const uint8_t *image, ptrdiff_t stride);
 double home__now(const home_context *ctx);
 

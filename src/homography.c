@@ -103,7 +103,7 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     lp.matches = ctx->matches;
     lp.scale = sqrt(cx * cx + cy * cy);
     lp.w_theta = cfg->theta_bins / HOME__PI;
-    lp.w_r = lp.scale / cfg->r_step;
+    lp.w_r = lp.scale / (cfg->r_step * ctx->hough_scale); /* Hough bins of the transform */
     set_identity(result->H);
     result->inliers = 0;
     if (n_matches < 8) { result->failure = HOME_FAIL_FEW_MATCHES; return HOME_OK; }

@@ -41,16 +41,23 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
     }
 }
 
-/* Copy the image into the zero-padded buffers (HOME__RADON_BLOCK columns each side) used by
- * the shear-and-add kernel: img_n as is, img_t transposed. */
+/* Copy the image (2x2-box downscaled when hough_downscale is 2) into the zero-padded buffers
+ * (HOME__RADON_BLOCK columns each side) used by the shear-and-add kernel: img_n as is, img_t
+ * transposed from it. */
 static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
 {
-    const int width = ctx->cfg.width, height = ctx->cfg.height, pad = HOME__RADON_BLOCK;
+    const int width = ctx->hough_w, height = ctx->hough_h, pad = HOME__RADON_BLOCK;
     int x, y;
     for (y = 0; y < height; y++) {
         uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
         memset(row, 0, (size_t)pad);
-        memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
+        if (ctx->hough_scale == 2) {
+            const uint8_t *s0 = image + (ptrdiff_t)(2 * y) * stride, *s1 = s0 + stride;
+            for (x = 0; x < width; x++)
+                row[pad + x] = (uint8_t)((s0[2 * x] + s0[2 * x + 1] + s1[2 * x] + s1[2 * x + 1] + 2) >> 2);
+        } else {
+            memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
+        }
         memset(row + pad + width, 0, (size_t)pad);
     }
     for (x = 0; x < width; x++) {
@@ -58,8 +65,8 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
         memset(row, 0, (size_t)pad);
         memset(row + pad + height, 0, (size_t)pad);
     }
-    for (y = 0; y < height; y++) {       /* transpose in 8-row strips for cache locality */
-        const uint8_t *src = image + (ptrdiff_t)y * stride;
+    for (y = 0; y < height; y++) {
+        const uint8_t *src = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride + pad;
         uint8_t *dst = ctx->img_t + pad + y;
         for (x = 0; x < width; x++) dst[(ptrdiff_t)x * ctx->img_t_stride] = src[x];
     }
@@ -78,8 +85,8 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
 {
     const double c = cos(theta), s = sin(theta);
     const int vertical = fabs(c) >= fabs(s);
-    const int rows = vertical ? ctx->cfg.height : ctx->cfg.width;
-    const int cols = vertical ? ctx->cfg.width : ctx->cfg.height;
+    const int rows = vertical ? ctx->hough_h : ctx->hough_w;
+    const int cols = vertical ? ctx->hough_w : ctx->hough_h;
     const ptrdiff_t img_stride = vertical ? ctx->img_n_stride : ctx->img_t_stride;
     const uint8_t *img = (vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK; /* column 0 */
     const double a = vertical ? c : s, b = vertical ? s : c, t = -b / a;

@@ -89,7 +89,10 @@ static void fill_keypoints(const home_context *ctx, home__heap *heap, int sign, 
         const home__candidate *c = &heap->items[i];
         home_keypoint *kp = &out[i];
         kp->theta = (float)(c->theta_bin * (HOME__PI / n_theta));
-        kp->r = (c->r_bin - centre_bin) * ctx->cfg.r_step;
+        /* r in full-image px: scale up from the (possibly downscaled) Hough image and move to
+         * the full image's centre */
+        kp->r = (float)(ctx->hough_scale * (c->r_bin - centre_bin) * ctx->cfg.r_step +
+                        cos((double)kp->theta) * ctx->hough_dx + sin((double)kp->theta) * ctx->hough_dy);
         kp->saliency = c->saliency;
         kp->sign = (int8_t)sign;
         kp->has_alt = (uint8_t)(c->theta_bin < (float)band || c->theta_bin > (float)(n_theta - band));
@@ -280,6 +283,8 @@ int home_keypoint_to_hough(const home_context *ctx, const home_keypoint *kp, flo
     if (status != HOME_OK) return status;
     if (!kp || !col || !row) return HOME_E_NULL;
     *row = (float)(kp->theta * ctx->cfg.theta_bins / HOME__PI);
-    *col = kp->r / ctx->cfg.r_step + 0.5f * (float)(ctx->r_bins - 1);
+    *col = (float)((kp->r - cos((double)kp->theta) * ctx->hough_dx -
+                    sin((double)kp->theta) * ctx->hough_dy) / (ctx->hough_scale * ctx->cfg.r_step) +
+                   0.5 * (ctx->r_bins - 1));
     return HOME_OK;
 }

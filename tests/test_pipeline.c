@@ -48,6 +48,38 @@ static void end_to_end(enum synth_kind kind, uint64_t seed0)
 }
 
 void test_end_to_end_structured(void) { end_to_end(SYNTH_STRUCTURED, 1000); }
+
+void test_downscaled_hough(void)
+{
+    /* hough_downscale = 2 (the video preset for small cores) still registers, coarser */
+    home_config cfg;
+    home_context *ctx;
+    double sum = 0;
+    int k, failures = 0;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.hough_downscale = 2;
+    cfg.refine_levels = 0;
+    ctx = test_context(IMG_W, IMG_H, &cfg);
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 4; k++) {
+        uint64_t seed = 3000 + (uint64_t)k;
+        double h[9];
+        home_result res;
+        synth_rng rng;
+        synth_seed(&rng, seed);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 20, h);
+        synth_render(SYNTH_STRUCTURED, (uint32_t)seed, identity, 2.5, 2 * seed + 1, img_a, IMG_W, IMG_H, IMG_W);
+        synth_render(SYNTH_STRUCTURED, (uint32_t)seed, h, 2.5, 2 * seed + 2, img_b, IMG_W, IMG_H, IMG_W);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        failures += !res.ok;
+        sum += synth_corner_error(res.H, h, IMG_W, IMG_H);
+    }
+    printf("     downscaled Hough, p=20: mean corner error %.3f px, %d/4 failed\n", sum / 4, failures);
+    CHECK_EQ_INT(failures, 0);
+    CHECK_LT(sum / 4, 1.5);
+    cfg.hough_method = HOME_HOUGH_EXACT;            /* only the fast transform downscales */
+    CHECK_EQ_INT(home_validate_config(&cfg), HOME_E_CONFIG);
+}
 void test_end_to_end_weak_texture(void) { end_to_end(SYNTH_WEAK_TEXTURE, 2000); }
 
 void test_video_reuse_matches_pair(void)
