@@ -9,7 +9,7 @@
 HARD_TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/test_bad_input*.c))
 HARD_TESTS := $(BUILD)/bin/home-hardening-tests
 FUZZ_REPLAY := $(BUILD)/bin/home-fuzz-replay
-FUZZ_TARGETS := api pgm y4m
+FUZZ_TARGETS := api stab pgm y4m
 FUZZ_REPLAY_OBJ := $(foreach t,$(FUZZ_TARGETS),$(BUILD)/obj/fuzz-replay/fuzz_$(t).o)
 FUZZ_SUPPORT := $(SUPPORT_OBJ) $(BUILD)/obj/examples/y4m.o
 BINS += $(HARD_TESTS) $(FUZZ_REPLAY)

@@ -139,10 +139,9 @@ static void check_result(const home_config *cfg, const home_result *res)
         double det = h[0] * (h[4] * h[8] - h[5] * h[7]) - h[1] * (h[3] * h[8] - h[5] * h[6]) +
                      h[2] * (h[3] * h[7] - h[4] * h[6]);
         FZ_CHECK(h[8] == 1.0 && det > 0.0);
-        if (res->failure == HOME_FAIL_NONE)
-            FZ_CHECK(res->inliers >= cfg->min_inliers);
-        else /* the refinement's rescue of a pair short of inliers (home.h's failure rule) */
-            FZ_CHECK(res->refined && res->failure == HOME_FAIL_FEW_INLIERS && res->inliers >= 8);
+        FZ_CHECK(res->failure == HOME_FAIL_NONE || res->failure == HOME_FAIL_FEW_INLIERS);
+        if (res->inliers < cfg->min_inliers) /* the refinement's rescue (home.h's failure rule) */
+            FZ_CHECK(res->refined && res->inliers >= 8 && res->refine_zncc >= 0.9);
     } else {
         FZ_CHECK(res->failure >= HOME_FAIL_FEW_MATCHES && res->failure <= HOME_FAIL_DEGENERATE);
     }

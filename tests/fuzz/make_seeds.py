@@ -84,6 +84,33 @@ def main():
     for name, data in y4m_seeds.items():
         (y4m / f"seed-{name}").write_bytes(data)
 
+    stab = ROOT / "stab"
+    stab.mkdir(parents=True, exist_ok=True)
+
+    def stab_seed(flags, side, lookahead, fmt, shift, frames, extra=b""):
+        """fuzz_stab.c layout: flags, sizes, keypoints, lookahead, scene, format, pad, shift, frames."""
+        b = u16(flags) + u16(side // 2 - 16) + u16(side // 2 - 16) + extra
+        b += u16(120 - 8) + u16(lookahead) + bytes([90]) + u16(8)
+        for _ in range(8):
+            x0, y0 = rng.randrange(50), rng.randrange(50)
+            b += u16(x0) + u16(y0) + u16(x0 + rng.randrange(4, 14)) + u16(y0 + rng.randrange(4, 14))
+            b += bytes([rng.randrange(256)])
+        b += u16(fmt) + u16(2) + u16(shift[0] + 3) + u16(shift[1] + 3) + u16(frames - 1)
+        return b + bytes(16)
+
+    stab_seeds = {
+        "grey-causal": stab_seed(0, 48, 0, 5, (1, 2), 4),
+        "i420-lookahead": stab_seed(0, 64, 2, 1, (2, -1), 5),
+        "nv12": stab_seed(0, 48, 1, 2, (-1, 1), 3),
+        "yuyv": stab_seed(0, 40, 0, 3, (1, 0), 3),
+        "i422": stab_seed(0, 48, 0, 4, (0, 1), 3),
+        "bad-format": stab_seed(0, 48, 0, 7, (0, 0), 2),
+        "arena-short": stab_seed(4, 48, 0, 5, (0, 0), 1),
+        "config-nan": stab_seed(2, 48, 0, 5, (1, 1), 2, extra=struct.pack("<f", float("nan")) + bytes(4) + bytes([0])),
+    }
+    for name, data in stab_seeds.items():
+        (stab / f"seed-{name}").write_bytes(data)
+
 
 if __name__ == "__main__":
     main()

@@ -1,0 +1,188 @@
+/* Fuzz the stabiliser API (home_stab_*): fuzzed configs and arena sizes, frame formats, sizes and
+ * strides, short clips of shifted frames, flush, reset, and the warper on fuzzed matrices. Valid
+ * calls must succeed, outputs must stay finite and in range, and every warp the stabiliser
+ * reports must be one home_stab_warp() accepts. */
+#include "fuzz_util.h"
+#include "home_stab.h"
+#include <math.h>
+
+#define FZ_SIDE_MAX 64
+#define FZ_FRAMES_MAX 5
+#define FZ_PLANE_BYTES (2 * (FZ_SIDE_MAX + 8) * FZ_SIDE_MAX)
+#define FZ_ARENA_BYTES (8u << 20)
+
+static union { unsigned char bytes[FZ_ARENA_BYTES]; double align; } arena;
+static uint8_t planes[FZ_FRAMES_MAX + 1][3][FZ_PLANE_BYTES];
+
+static int is_status(int s)
+{
+    return s <= HOME_OK && s >= HOME_E_BUFFER;
+}
+
+/* Rows of plane p of a w x h frame in format fmt, and bytes per row. */
+static void plane_shape(int fmt, int p, int w, int h, int *rows, int *row_bytes)
+{
+    *rows = h;
+    *row_bytes = w;
+    if (fmt == HOME_STAB_YUYV) *row_bytes = 2 * w;
+    if (p == 0) return;
+    if (fmt == HOME_STAB_I420 || fmt == HOME_STAB_NV12) *rows = h / 2;
+    if (fmt != HOME_STAB_NV12) *row_bytes = w / 2;
+}
+
+static int plane_count(int fmt)
+{
+    return fmt == HOME_STAB_I420 || fmt == HOME_STAB_I422 ? 3 : fmt == HOME_STAB_NV12 ? 2 : 1;
+}
+
+/* Frame k: the base scene shifted by (k*dx, k*dy); planes end where their buffers end. Returns
+ * 1 when the frame is well formed. */
+static int make_frame(fz_reader *r, home_stab_image *im, int k, int fmt, int w, int h, int pad,
+                      const uint8_t *scene, int dx, int dy)
+{
+    int p, x, y, valid = fmt >= HOME_STAB_I420 && fmt <= HOME_STAB_GREY;
+    memset(im, 0, sizeof *im);
+    im->format = fmt;
+    im->width = w;
+    im->height = h;
+    for (p = 0; p < (valid ? plane_count(fmt) : 1); p++) {
+        int rows, row_bytes;
+        plane_shape(valid ? fmt : HOME_STAB_GREY, p, w, h, &rows, &row_bytes);
+        im->stride[p] = row_bytes + pad;
+        im->plane[p] = planes[k][p] + FZ_PLANE_BYTES - ((size_t)(rows - 1) * (size_t)im->stride[p] + (size_t)row_bytes);
+        for (y = 0; y < rows; y++)
+            for (x = 0; x < row_bytes; x++) {
+                int sx = (x + k * dx) & 63, sy = (y + k * dy) & 63;
+                im->plane[p][y * im->stride[p] + x] = p ? (uint8_t)(128 + x) : scene[sy * 64 + sx];
+            }
+    }
+    if (fz_u8(r) == 0xff) { im->plane[0] = NULL; valid = 0; }
+    return valid;
+}
+
+static void check_output(const home_stab_output *out)
+{
+    int k;
+    FZ_CHECK(out->ready == 0 || out->ready == 1);
+    if (!out->ready) return;
+    for (k = 0; k < 9; k++) FZ_CHECK(isfinite(out->warp[k]));
+    FZ_CHECK(out->correction_used >= 0.0 && out->correction_used <= 1.0);
+    FZ_CHECK(out->motion_status >= HOME_STAB_MOTION_FIRST && out->motion_status <= HOME_STAB_MOTION_IMPLAUSIBLE);
+    FZ_CHECK(isfinite(out->raw.tx) && isfinite(out->raw.ty) && isfinite(out->smooth.angle));
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_reader rd = {data, size, 0}, *r = &rd;
+    unsigned flags = fz_u16(r);
+    home_stab_config cfg;
+    home_stab *stab = NULL;
+    home_stab_image frames[FZ_FRAMES_MAX], dst;
+    home_stab_output out;
+    uint8_t scene[64 * 64];
+    size_t need, have;
+    int w = 2 * fz_range(r, HOME_MIN_SIDE / 2, FZ_SIDE_MAX / 2), h = 2 * fz_range(r, HOME_MIN_SIDE / 2, FZ_SIDE_MAX / 2);
+    int s, k, n, fmt, pad, dx, dy, valid[FZ_FRAMES_MAX], pushed = 0;
+    long last = -1;
+
+    if (flags & 1) { w = (int16_t)fz_u16(r); h = (int16_t)fz_u16(r); }
+    s = home_stab_default_config(&cfg, w, h);
+    FZ_CHECK(is_status(s));
+    cfg.keypoints_per_sign = fz_range(r, 8, 150);
+    cfg.lookahead = fz_range(r, 0, 3);
+    cfg.downscale = 1;
+    if (flags & 2) {
+        float f = fz_float_bits(r);
+        int32_t raw = (int32_t)fz_u32(r);
+        switch (fz_u8(r) % 10) {
+        case 0: cfg.margin = f; break;
+        case 1: cfg.smoothing = f; break;
+        case 2: cfg.lookahead = raw % 256; break;
+        case 3: cfg.downscale = raw % 8; break;
+        case 4: cfg.keypoints_per_sign = raw % 2048; break;
+        case 5: cfg.min_inliers = raw % 64; break;
+        case 6: cfg.max_shift = f; break;
+        case 7: cfg.max_rotation = f; break;
+        case 8: cfg.max_zoom = f; break;
+        default: cfg.max_residual = f; break;
+        }
+    }
+    s = home_stab_validate_config(&cfg);
+    FZ_CHECK(is_status(s));
+    need = home_stab_arena_size(&cfg);
+    FZ_CHECK((s == HOME_OK) == (need > 0));
+    have = need && need <= FZ_ARENA_BYTES ? need : FZ_ARENA_BYTES;
+    if ((flags & 4) && need > 1) have = need - 1;
+    {
+        size_t needed = 0;
+        int want = s != HOME_OK ? s : need > have ? HOME_E_ARENA_SMALL : HOME_OK;
+        s = home_stab_init(&stab, &cfg, arena.bytes + FZ_ARENA_BYTES - (have & ~(size_t)15) - (have & 15 ? 16 : 0),
+                           have, &needed);
+        FZ_CHECK(s == want);
+        if (s == HOME_E_ARENA_SMALL) FZ_CHECK(needed == need);
+        if (s != HOME_OK) return 0;
+    }
+    if (cfg.width > FZ_SIDE_MAX || cfg.height > FZ_SIDE_MAX) return 0;
+
+    /* a scene of rectangles; frames are it shifted by (dx, dy) per frame */
+    memset(scene, (int)fz_u8(r), sizeof scene);
+    for (k = fz_range(r, 0, 10); k > 0; k--) {
+        int x0 = fz_range(r, 0, 63), y0 = fz_range(r, 0, 63), x1 = fz_range(r, x0, 63), y1 = fz_range(r, y0, 63);
+        int v = (int)fz_u8(r), x, y;
+        for (y = y0; y <= y1; y++)
+            for (x = x0; x <= x1; x++) scene[y * 64 + x] = (uint8_t)v;
+    }
+    fmt = fz_range(r, 0, HOME_STAB_GREY + 1);
+    pad = fz_range(r, 0, 8);
+    dx = fz_range(r, -3, 3);
+    dy = fz_range(r, -3, 3);
+    n = fz_range(r, 1, FZ_FRAMES_MAX);
+    for (k = 0; k < n; k++) valid[k] = make_frame(r, &frames[k], k, fmt, cfg.width, cfg.height, pad, scene, dx, dy);
+
+    for (k = 0; k < n; k++) {
+        s = home_stab_push(stab, &frames[k], &out);
+        FZ_CHECK(is_status(s));
+        if (valid[k]) FZ_CHECK(s == HOME_OK);
+        else FZ_CHECK(s != HOME_OK);
+        if (s != HOME_OK) continue;
+        pushed++;
+        check_output(&out);
+        if (out.ready) {
+            FZ_CHECK(out.frame > last && out.frame < k + 1);
+            last = out.frame;
+            /* the stabiliser's own warp is one the warper accepts */
+            if (make_frame(r, &dst, FZ_FRAMES_MAX, fmt, cfg.width, cfg.height, 0, scene, 0, 0) &&
+                valid[out.frame])
+                FZ_CHECK(home_stab_warp(out.warp, &frames[out.frame], &dst) == HOME_OK);
+        }
+    }
+    for (k = 0; k <= HOME_STAB_MAX_LOOKAHEAD + 1; k++) {
+        FZ_CHECK(home_stab_flush(stab, &out) == HOME_OK);
+        check_output(&out);
+        if (!out.ready) break;
+        FZ_CHECK(out.frame > last);
+        last = out.frame;
+    }
+    FZ_CHECK(k <= cfg.lookahead);
+
+    /* the warper on any matrix: refused or done, never out of bounds */
+    if (pushed && valid[0]) {
+        double m[9];
+        home_stab_sim sim;
+        for (k = 0; k < 9; k++) m[k] = (fz_u8(r) & 1) ? (double)fz_float_bits(r) : (k % 4 == 0);
+        make_frame(r, &dst, FZ_FRAMES_MAX, fmt, cfg.width, cfg.height, fz_range(r, 0, 4), scene, 0, 0);
+        s = home_stab_warp(m, &frames[0], &dst);
+        FZ_CHECK(s == HOME_OK || s == HOME_E_CONFIG);
+        sim.tx = fz_float_bits(r);
+        sim.ty = fz_float_bits(r);
+        sim.angle = fz_float_bits(r);
+        sim.log_scale = fz_float_bits(r);
+        home_stab_sim_to_matrix(&sim, cfg.width, cfg.height, m);
+    }
+    FZ_CHECK(home_stab_reset(stab) == HOME_OK);
+    if (valid[0]) {
+        FZ_CHECK(home_stab_push(stab, &frames[0], &out) == HOME_OK);
+        FZ_CHECK(out.newest_status == HOME_STAB_MOTION_FIRST);
+    }
+    return 0;
+}
