@@ -10,13 +10,14 @@ $SUDO apt-get install -y -qq --no-install-recommends gcc-aarch64-linux-gnu gcc-a
   binutils-arm-linux-gnueabihf > /dev/null
 pids=()
 for target in aarch64-linux-gnu arm-linux-gnueabihf; do
-  make -s test CROSS_COMPILE=$target- BUILD=build-$target > "build-$target.log" 2>&1 &
+  mkdir -p build-$target
+  make -s test CROSS_COMPILE=$target- BUILD=build-$target > "build-$target/test.log" 2>&1 &
   pids+=($!)
 done
 status=0
 for i in 0 1; do
   target=$([ $i = 0 ] && echo aarch64-linux-gnu || echo arm-linux-gnueabihf)
-  if wait "${pids[$i]}"; then echo "--- $target: $(tail -n 1 build-$target.log)"
-  else echo "--- $target FAILED:"; grep -E 'FAIL|error|Error' "build-$target.log" | head -40; tail -n 3 "build-$target.log"; status=1; fi
+  if wait "${pids[$i]}"; then echo "--- $target: $(tail -n 1 build-$target/test.log)"
+  else echo "--- $target FAILED:"; grep -E 'FAIL|error|Error' "build-$target/test.log" | head -40; tail -n 3 "build-$target/test.log"; status=1; fi
 done
 exit $status
