@@ -30,7 +30,8 @@ enum {
     FLAG_VIDEO = 1 << 8,         /* extract both frames again and match: same result as the pair */
     FLAG_CLOCK = 1 << 9,         /* a timing hook is set */
     FLAG_REFINE = 1 << 10,       /* home_refine() from a fuzzed initial H */
-    FLAG_EXACT = 1 << 11         /* the exact (pixel by pixel) Hough method */
+    FLAG_EXACT = 1 << 11,        /* the exact (pixel by pixel) Hough method */
+    FLAG_HOUGH_HALF = 1 << 12    /* the Hough transform of a 2x2-downscaled copy */
 };
 
 static union { unsigned char bytes[FZ_ARENA_BYTES]; double align; } arena;
@@ -153,7 +154,7 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
     for (k = 0; k < n; k++) {
         int32_t raw = (int32_t)fz_u32(r);
         float f = fz_float_bits(r);
-        switch (fz_u8(r) % 16) {
+        switch (fz_u8(r) % 17) {
         case 0: cfg->theta_bins = raw % 4096; break;
         case 1: cfg->wrap_band = raw % 1024; break;
         case 2: cfg->r_step = f; break;
@@ -169,6 +170,7 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
         case 12: cfg->refine_trust_px = f; break;
         case 13: cfg->simd = raw % 8; break;
         case 14: cfg->hough_method = raw % 4; break;
+        case 15: cfg->hough_downscale = raw % 4; break;
         default: cfg->width = raw; break;
         }
     }
@@ -236,6 +238,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     cfg.min_inliers = fz_range(r, 4, 30);
     cfg.simd = fz_range(r, HOME_SIMD_AUTO, HOME_SIMD_AVX2 + 1); /* uncompiled ones are refused */
     if (flags & FLAG_EXACT) cfg.hough_method = HOME_HOUGH_EXACT;
+    if (flags & FLAG_HOUGH_HALF) cfg.hough_downscale = 2;
     if (flags & FLAG_CLOCK) {
         cfg.clock = fake_clock;
         cfg.clock_user = &ticks;
