@@ -23,3 +23,54 @@ $(BUILD)/obj/tests/stab/test_stab.o: tests/test_stab.c include/home_stab.h src/s
 $(BUILD)/bin/home-stab-tests: $(BUILD)/obj/tests/stab/test_stab.o $(STAB_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+
+# --- optional examples: built when their dependency is present, else named as skipped -------
+PKG_CONFIG ?= $(CROSS_COMPILE)pkg-config
+ifeq ($(origin CXX),default)
+CXX := $(CROSS_COMPILE)g++
+endif
+STAB_HAVE_V4L2 := $(shell printf '\043include <linux/videodev2.h>\n' | $(CC) -E -x c - > /dev/null 2>&1 && echo 1)
+STAB_HAVE_SDL2 := $(shell $(PKG_CONFIG) --exists sdl2 2> /dev/null && echo 1)
+STAB_HAVE_LIBCAMERA := $(shell $(PKG_CONFIG) --exists libcamera 2> /dev/null && command -v $(CXX) > /dev/null && echo 1)
+STAB_SKIPPED :=
+ifeq ($(STAB_HAVE_V4L2),1)
+BINS += $(BUILD)/bin/eis-v4l2 $(BUILD)/lib/fake_v4l2.so
+ifneq ($(STAB_HAVE_SDL2),1)
+STAB_SKIPPED += eis-v4l2 window (SDL2 not found: apt-get install libsdl2-dev; built without it)
+endif
+else
+STAB_SKIPPED += eis-v4l2 (no <linux/videodev2.h>: apt-get install linux-libc-dev)
+endif
+ifeq ($(STAB_HAVE_LIBCAMERA),1)
+BINS += $(BUILD)/bin/eis-libcamera
+else
+STAB_SKIPPED += eis-libcamera (libcamera or a C++17 compiler not found: apt-get install libcamera-dev g++ pkg-config)
+endif
+ifneq ($(strip $(STAB_SKIPPED)),)
+$(info stab: skipped: $(strip $(STAB_SKIPPED)))
+endif
+
+$(BUILD)/obj/examples/eis-v4l2.o: examples/eis-v4l2.c examples/eis_common.h include/home_stab.h include/home.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $(if $(filter 1,$(STAB_HAVE_SDL2)),-DHAVE_SDL2 $(shell $(PKG_CONFIG) --cflags sdl2)) -c $< -o $@
+
+$(BUILD)/bin/eis-v4l2: $(BUILD)/obj/examples/eis-v4l2.o $(BUILD)/obj/examples/eis_common.o $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) $(if $(filter 1,$(STAB_HAVE_SDL2)),$(shell $(PKG_CONFIG) --libs sdl2))
+
+# the fake camera is test support: never sanitized (it is preloaded into sanitized programs)
+$(BUILD)/lib/fake_v4l2.so: tests/fake_v4l2/fake_v4l2.c
+	@mkdir -p $(dir $@)
+	$(CC) -std=c99 -O2 -g $(WARN) -fPIC -shared $< -o $@ -ldl
+
+$(BUILD)/bin/eis-libcamera: examples/eis-libcamera.cpp examples/eis_common.h $(BUILD)/obj/examples/eis_common.o include/home_stab.h include/home.h $(LIB)
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++17 $(OPT) -g -Wall -Wextra -Werror -Iinclude $(ARCH_FLAGS) $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) \
+		-Iexamples $(shell $(PKG_CONFIG) --cflags libcamera) $< $(BUILD)/obj/examples/eis_common.o $(LIB) -o $@ $(LDFLAGS_APP) $(shell $(PKG_CONFIG) --libs libcamera) -pthread
+
+# the stabiliser's header goes with the library
+install: stab-install-header
+.PHONY: stab-install-header
+stab-install-header:
+	install -d $(DESTDIR)$(PREFIX)/include
+	install -m 644 include/home_stab.h $(DESTDIR)$(PREFIX)/include/
