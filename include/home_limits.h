@@ -32,6 +32,9 @@
 #ifndef HOME_LM_MAX_ITERS
 #define HOME_LM_MAX_ITERS 20
 #endif
+#ifndef HOME_LM_COARSE_ITERS
+#define HOME_LM_COARSE_ITERS 5
+#endif
 #ifndef HOME_MAX_THRESHOLD_LEVELS
 #define HOME_MAX_THRESHOLD_LEVELS 12
 #endif

@@ -112,7 +112,10 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     for (level = 0; level < HOME_MAX_THRESHOLD_LEVELS; level++) {
         n_in = select_inliers(&lp, n_matches, g, t, ctx->inlier_index);
         if (n_in < 6) break;               /* too few lines left to constrain 8 parameters */
-        if (!home__lm_solve(g, n_in, ctx->inlier_index, line_residual, &lp, HOME_LM_MAX_ITERS))
+        /* coarse levels only move the estimate into the next, narrower gate: a few iterations
+         * do; the final level converges fully */
+        if (!home__lm_solve(g, n_in, ctx->inlier_index, line_residual, &lp,
+                            t <= cfg->threshold_final ? HOME_LM_MAX_ITERS : HOME_LM_COARSE_ITERS))
             break;
         if (t <= cfg->threshold_final) break;
         t = t * 0.5 > cfg->threshold_final ? t * 0.5 : cfg->threshold_final;

@@ -58,21 +58,26 @@ int home__lm_solve(double *p, int n, const int *index, home__residual_fn fn, con
     if (!isfinite(cost)) return 0;
     for (it = 0; it < max_iters; it++) {
         double jtj[NP * NP], jte[NP], e[3], jac[3 * NP];
-        int i, r, a, b, tries, improved = 0;
+        int i, r, a, tries, improved = 0;
         memset(jtj, 0, sizeof jtj);
         memset(jte, 0, sizeof jte);
         for (i = 0; i < n; i++) {
             fn(user, index[i], p, e, jac);
+            /* the full square, unrolled; Jacobian rows are often partly zero */
             for (r = 0; r < 3; r++) {
                 const double *row = jac + r * NP;
                 for (a = 0; a < NP; a++) {
-                    jte[a] += row[a] * e[r];
-                    for (b = 0; b <= a; b++) jtj[a * NP + b] += row[a] * row[b];
+                    const double ra = row[a];
+                    double *dst = jtj + a * NP;
+                    if (ra == 0.0) continue;
+                    jte[a] += ra * e[r];
+                    dst[0] += ra * row[0]; dst[1] += ra * row[1];
+                    dst[2] += ra * row[2]; dst[3] += ra * row[3];
+                    dst[4] += ra * row[4]; dst[5] += ra * row[5];
+                    dst[6] += ra * row[6]; dst[7] += ra * row[7];
                 }
             }
         }
-        for (a = 0; a < NP; a++)
-            for (b = 0; b < a; b++) jtj[b * NP + a] = jtj[a * NP + b];
         for (tries = 0; tries < LM_MAX_TRIES; tries++) {
             double m[NP * NP], step[NP], trial[NP], new_cost;
             memcpy(m, jtj, sizeof m);
