@@ -34,6 +34,8 @@ static void usage(FILE *f)
         "  --sigma BINS         Gaussian smoothing of the Hough image (default 1.3)\n"
         "  --hough-downscale N  1: Hough transform of the full image (default); 2: of a 2x2-box\n"
         "                       downscaled copy (4x less Hough work, for video on small cores)\n"
+        "  --theta-window N     motion prior: match only keypoints within N theta bins of each\n"
+        "                       other (0 = off, the default; ~27 bins = 10 degrees for video)\n"
         "  --ratio R            Lowe ratio test (default 0.9)\n"
         "  --threshold T        final inlier threshold in Hough pixels (default 1.0)\n"
         "  --threshold-start T  first inlier threshold, halved down to the final (default 64)\n"
@@ -129,7 +131,8 @@ int main(int argc, char **argv)
     const char *paths[2] = {NULL, NULL}, *hough_path = NULL;
     home_config cfg;
     int n_paths = 0, i, repeat = 1, status, s;
-    int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_downscale = -1;
+    int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_downscale = -1,
+        opt_window = -1;
     float opt_rtrust = -1;
     float opt_ratio = -1, opt_thr = -1, opt_thr0 = -1, opt_rstep = -1, opt_sigma = -1;
     uint8_t *buf_a = NULL, *buf_b = NULL;
@@ -163,6 +166,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--r-step")) bad = parse_float(v, &opt_rstep), i++;
         else if (!strcmp(a, "--sigma")) bad = parse_float(v, &opt_sigma), i++;
         else if (!strcmp(a, "--hough-downscale")) bad = parse_int(v, &opt_downscale), i++;
+        else if (!strcmp(a, "--theta-window")) bad = parse_int(v, &opt_window), i++;
         else if (!strcmp(a, "--save-hough")) hough_path = v, i++;
         else if (!strncmp(a, "--", 2)) { fprintf(stderr, "home-register: unknown option %s\n", a); usage(stderr); return 2; }
         else if (n_paths < 2) paths[n_paths++] = a;
@@ -193,6 +197,7 @@ int main(int argc, char **argv)
     if (opt_rstep >= 0) cfg.r_step = opt_rstep;
     if (opt_sigma >= 0) cfg.smooth_sigma = opt_sigma;
     if (opt_downscale >= 0) cfg.hough_downscale = opt_downscale;
+    if (opt_window >= 0) cfg.match_theta_window = opt_window;
     if (opt_rlevels >= 0) cfg.refine_levels = opt_rlevels;
     if (opt_riters >= 0) cfg.refine_iterations = opt_riters;
     if (opt_rtrust >= 0) cfg.refine_trust_px = opt_rtrust;

@@ -89,6 +89,9 @@ typedef struct home_config {
     int hough_downscale;      /* 1: Hough transform of the image itself; 2: of its 2x2-box
                                  downscaled copy (FAST only): ~4x less Hough work, for video on
                                  small cores; r bins are then 2*r_step px of the full image */
+    int match_theta_window;   /* video motion prior: 0 = off (default, still pairs); N > 0 =
+                                 a keypoint is only compared with keypoints whose theta lies
+                                 within N bins of its own (the frame rotates less than that) */
     home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */
     void *clock_user;
 } home_config;

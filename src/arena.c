@@ -41,6 +41,7 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->simd = HOME_SIMD_AUTO;
     cfg->hough_method = HOME_HOUGH_FAST;
     cfg->hough_downscale = 1;
+    cfg->match_theta_window = 0;
 #ifndef HOME_NO_GETENV
     {
         const char *env = getenv("HOME_SIMD");
@@ -121,6 +122,8 @@ int home_validate_config(const home_config *cfg)
         (cfg->hough_downscale != 2 || cfg->hough_method != HOME_HOUGH_FAST ||
          cfg->width / 2 < HOME_MIN_SIDE || cfg->height / 2 < HOME_MIN_SIDE))
         return HOME_E_CONFIG;
+    if (cfg->match_theta_window < 0 || cfg->match_theta_window > cfg->theta_bins)
+        return HOME_E_CONFIG;
     return HOME_OK;
 }
 
@@ -147,6 +150,7 @@ uint32_t home__config_id(const home_config *cfg)
 #define BLOCK_ALIGN 64u
 
 typedef struct layout {
+    size_t window_desc, window_theta, window_index;
     size_t img_n, img_t, shift, row_lo, row_hi, first_row, line_sum, edge_prefix, line_j;
     ptrdiff_t img_n_stride, img_t_stride;
     size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, matches,
@@ -205,6 +209,12 @@ static void plan(const home_config *cfg, layout *l)
     l->matches = take(&cur, (size_t)l->max_matches * sizeof(home__match));
     l->inliers = take(&cur, (size_t)l->max_matches * sizeof(int));
     l->slots = take(&cur, 2 * sizeof(home_features));
+    {   /* b's keypoints sorted by theta, for the motion prior */
+        size_t kp = 2 * (size_t)cfg->keypoints_per_sign;
+        l->window_desc = take(&cur, kp * HOME_DESC_LEN);
+        l->window_theta = take(&cur, kp * sizeof(float));
+        l->window_index = take(&cur, kp * sizeof(int));
+    }
     l->refine = take(&cur, home__refine_bytes(cfg));
     l->total = (cur + BLOCK_ALIGN - 1) & ~(size_t)(BLOCK_ALIGN - 1);
 }
@@ -275,6 +285,9 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
     ctx->max_matches = l.max_matches;
     ctx->inlier_index = (int *)(void *)(base + l.inliers);
     ctx->slots = (home_features *)(void *)(base + l.slots);
+    ctx->window_desc = base + l.window_desc;
+    ctx->window_theta = (float *)(void *)(base + l.window_theta);
+    ctx->window_index = (int *)(void *)(base + l.window_index);
     ctx->slots[0].magic = ctx->slots[1].magic = 0;
     ctx->slots_valid = 0;
     home__refine_init(ctx, base + l.refine);

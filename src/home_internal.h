@@ -90,6 +90,9 @@ struct home_context {
     int max_matches;
     int *inlier_index;                /* max_matches: indices of current inliers */
     home_features *slots;             /* 2: home_register()'s own features */
+    uint8_t *window_desc;             /* motion prior: b's descriptors in theta order per sign */
+    float *window_theta;              /*   their theta */
+    int *window_index;                /*   their index in b */
     int slots_valid;
     home__refine_state refine;
 };

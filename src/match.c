@@ -4,6 +4,7 @@
  * wrap between two frames (home-notes.md, finding 4). */
 #include "home_internal.h"
 #include <math.h>
+#include <string.h>
 
 void home__match_set(home__match *m, float theta_a, float r_a, float theta_b, float r_b)
 {
@@ -23,24 +24,90 @@ static int best_match(const home__kernels *kernels, const uint8_t *desc, const h
     return (float)d1 < ratio * (float)d2 ? lo + best : -1;
 }
 
+/* theta order with the index as tie break: a strict total order */
+static int theta_before(const home_features *b, int i, int j)
+{
+    if (b->kp[i].theta != b->kp[j].theta) return b->kp[i].theta < b->kp[j].theta;
+    return i < j;
+}
+
+static void sift_down(const home_features *b, int *idx, int n, int i)
+{
+    for (;;) {
+        int l = 2 * i + 1, r = l + 1, m = i, t;
+        if (l < n && theta_before(b, idx[m], idx[l])) m = l;
+        if (r < n && theta_before(b, idx[m], idx[r])) m = r;
+        if (m == i) return;
+        t = idx[i]; idx[i] = idx[m]; idx[m] = t;
+        i = m;
+    }
+}
+
+/* b's keypoints [lo, hi) in theta order (heap sort, no recursion): their descriptors packed
+ * contiguously, so a theta window is one run for the nearest-neighbour kernel. */
+static void sort_by_theta(home_context *ctx, const home_features *b, int lo, int hi)
+{
+    int *idx = ctx->window_index + lo, n = hi - lo, i, t;
+    for (i = 0; i < n; i++) idx[i] = lo + i;
+    for (i = n / 2 - 1; i >= 0; i--) sift_down(b, idx, n, i);
+    for (i = n - 1; i > 0; i--) {
+        t = idx[0]; idx[0] = idx[i]; idx[i] = t;
+        sift_down(b, idx, i, 0);
+    }
+    for (i = 0; i < n; i++) {
+        memcpy(ctx->window_desc + (size_t)(lo + i) * HOME_DESC_LEN, b->kp[idx[i]].desc, HOME_DESC_LEN);
+        ctx->window_theta[lo + i] = b->kp[idx[i]].theta;
+    }
+}
+
+/* first position in [lo, hi) whose theta is >= value */
+static int lower_bound(const float *theta, int lo, int hi, float value)
+{
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (theta[mid] < value) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* Best candidate among b's keypoints [lo, hi) within +- window of theta, or -1. */
+static int best_match_window(const home_context *ctx, const uint8_t *desc, float theta, int lo,
+                             int hi, float window, float ratio)
+{
+    int p0 = lower_bound(ctx->window_theta, lo, hi, theta - window);
+    int p1 = lower_bound(ctx->window_theta, p0, hi, theta + window + 1e-6f);
+    int best, d1, d2;
+    if (p1 - p0 < 2) return -1;
+    ctx->kernels->nearest2_l1(desc, ctx->window_desc + (size_t)p0 * HOME_DESC_LEN, HOME_DESC_LEN,
+                              p1 - p0, &best, &d1, &d2);
+    return (float)d1 < ratio * (float)d2 ? ctx->window_index[p0 + best] : -1;
+}
+
 int home__match_features(home_context *ctx, const home_features *a, const home_features *b)
 {
     const float ratio = ctx->cfg.ratio;
+    const float window = (float)(ctx->cfg.match_theta_window * HOME__PI / ctx->cfg.theta_bins);
     int i, n = 0;
+    if (window > 0.0f) {
+        sort_by_theta(ctx, b, 0, b->n_pos);
+        sort_by_theta(ctx, b, b->n_pos, b->n_pos + b->n_neg);
+    }
     for (i = 0; i < a->n_pos + a->n_neg; i++) {
         const home_keypoint *q = &a->kp[i];
         int same_lo = q->sign > 0 ? 0 : b->n_pos, same_hi = q->sign > 0 ? b->n_pos : b->n_pos + b->n_neg;
         int opp_lo = q->sign > 0 ? b->n_pos : 0, opp_hi = q->sign > 0 ? b->n_pos + b->n_neg : b->n_pos;
-        int j = best_match(ctx->kernels, q->desc, b, same_lo, same_hi, ratio);
+        float alt_theta = q->theta < (float)(HOME__PI / 2) ? q->theta + (float)HOME__PI
+                                                            : q->theta - (float)HOME__PI;
+        int j = window > 0.0f ? best_match_window(ctx, q->desc, q->theta, same_lo, same_hi, window, ratio)
+                              : best_match(ctx->kernels, q->desc, b, same_lo, same_hi, ratio);
         if (j >= 0 && n < ctx->max_matches)
             home__match_set(&ctx->matches[n++], q->theta, q->r, b->kp[j].theta, b->kp[j].r);
         if (!q->has_alt) continue;
-        j = best_match(ctx->kernels, q->alt_desc, b, opp_lo, opp_hi, ratio);
+        j = window > 0.0f ? best_match_window(ctx, q->alt_desc, alt_theta, opp_lo, opp_hi, window, ratio)
+                          : best_match(ctx->kernels, q->alt_desc, b, opp_lo, opp_hi, ratio);
         if (j >= 0 && n < ctx->max_matches)
-            home__match_set(&ctx->matches[n++],
-                            q->theta < (float)(HOME__PI / 2) ? q->theta + (float)HOME__PI
-                                                             : q->theta - (float)HOME__PI,
-                            -q->r, b->kp[j].theta, b->kp[j].r);
+            home__match_set(&ctx->matches[n++], alt_theta, -q->r, b->kp[j].theta, b->kp[j].r);
     }
     return n;
 }

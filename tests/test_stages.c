@@ -266,3 +266,34 @@ void test_halving_with_outliers(void)
         CHECK_LT(synth_corner_error(res.H, h, IMG_W, IMG_H), 0.3);
     }
 }
+
+void test_theta_window_prior(void)
+{
+    /* with the motion prior every match pairs lines within the window, and registration holds */
+    enum { PW = 640, PH = 360 };
+    static uint8_t a[PW * PH], b[PW * PH];
+    double h[9], ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    home_config cfg;
+    home_context *ctx;
+    home_result res;
+    synth_rng rng;
+    int i, outside = 0;
+    synth_seed(&rng, 61);
+    synth_corner_homography(&rng, PW, PH, 20, h);
+    synth_render(SYNTH_STRUCTURED, 61, ident, 2.5, 1, a, PW, PH, PW);
+    synth_render(SYNTH_STRUCTURED, 61, h, 2.5, 2, b, PW, PH, PW);
+    home_default_config(&cfg, PW, PH);
+    cfg.match_theta_window = 12;
+    cfg.refine_levels = 0;
+    ctx = test_context(PW, PH, &cfg);
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_register(ctx, a, PW, b, PW, &res), HOME_OK);
+    CHECK(res.ok);
+    CHECK_LT(synth_corner_error(res.H, h, PW, PH), 1.0);
+    for (i = 0; i < res.matches; i++) {
+        double d = fabs((double)ctx->matches[i].theta_a - ctx->matches[i].theta_b) * 480 / HOME__PI;
+        if (d > 12.0 + 1e-3) outside++;
+    }
+    CHECK_EQ_INT(outside, 0);
+    CHECK(res.matches > 100);
+}
