@@ -226,10 +226,12 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
 {
     home__refine_state *st = &ctx->refine;
     int l, slot;
-    int16_t *row_tmp = (int16_t *)st->scratch;
-    uint16_t *cells = (uint16_t *)(void *)((unsigned char *)st->scratch +
-                                           align64((size_t)st->w[0] * sizeof(int16_t)));
-    if (!st->levels) return 0;
+    int16_t *row_tmp;
+    uint16_t *cells;
+    if (!st->levels) return 0; /* refinement off: no scratch (arithmetic on NULL is undefined) */
+    row_tmp = (int16_t *)st->scratch;
+    cells = (uint16_t *)(void *)((unsigned char *)st->scratch +
+                                 align64((size_t)st->w[0] * sizeof(int16_t)));
     st->rk->blur3(image, stride, st->pyr[0], st->w[0], st->w[0], st->h[0], row_tmp);
     for (l = 1; l < st->levels; l++)
         st->rk->downsample(st->pyr[l - 1], st->w[l - 1], st->pyr[l], st->w[l], st->w[l], st->h[l]);
