@@ -181,7 +181,7 @@ typedef struct home_result {
     int refined;              /* 1: H is HOME's estimate refined photometrically */
     int refine_status;        /* enum home_refine_status */
     int refine_iterations;    /* Gauss-Newton iterations over all levels */
-    double refine_error[2];   /* robust photometric error (mean Cauchy cost, grey levels^2) of
+    double refine_error[2];   /* robust photometric error (mean Geman-McClure cost, grey^2) of
                                  HOME's H and of the refined H over the points both keep */
     double refine_zncc;       /* weighted correlation of A and gain/bias-corrected B there */
     double ms[HOME_STAGE_COUNT]; /* per-stage milliseconds (0 without a clock) */

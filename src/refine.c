@@ -37,7 +37,7 @@
                                  ill conditioned */
 
 /* Block side of the point selection per level: 4x4 at full resolution, 2x2, then 1x1. */
-static int block_side(int level) { return level == 0 ? 4 : level == 1 ? 2 : 1; }
+static int block_side(int level) { return level == 2 ? 2 : 4; }
 
 /* Selection floor of the score |gx| + |gy| (2x central differences of the blurred level): above
  * the best of a block of pure camera noise up to sigma ~3 grey levels (the blur and each 2x2
@@ -111,7 +111,7 @@ size_t home__refine_bytes(const home_config *cfg)
     int l, n = cfg->refine_levels ? levels_for(cfg) : 0;
     for (l = 0; l < n; l++) {
         total += align64((size_t)(cfg->width >> l) * (size_t)(cfg->height >> l));
-        total += 2 * 5 * align64((size_t)level_capacity(l) * sizeof(int16_t));
+        total += 2 * 5 * align64((size_t)(level_capacity(l) + LANES) * sizeof(int16_t));
     }
     if (n) total += align64(scratch_bytes(cfg));
     return total;
@@ -132,7 +132,7 @@ void home__refine_init(home_context *ctx, unsigned char *block)
         block += align64((size_t)st->w[l] * (size_t)st->h[l]);
         for (s = 0; s < 2; s++) {
             home__refine_points *p = &st->tpl[s][l];
-            size_t bytes = align64((size_t)level_capacity(l) * sizeof(int16_t));
+            size_t bytes = align64((size_t)(level_capacity(l) + LANES) * sizeof(int16_t));
             p->capacity = level_capacity(l);
             p->x = (int16_t *)(void *)block; block += bytes;
             p->y = (int16_t *)(void *)block; block += bytes;
@@ -168,10 +168,11 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
                           int level, int16_t *keys, uint16_t *cells, home__refine_points *out)
 {
     const int b = block_side(level);
-    const int bw = (w + b - 1) / b, bh = (h + b - 1) / b, n_blocks = bw * bh;
-    int hist[256], bx, by, x, y, dy, bin, quota, n = 0, cut, above, i, j;
+    const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
+    const int log2b = b == 4 ? 2 : b == 2 ? 1 : 0;
+    int hist[256], hist4[4][256], bx, by, x, y, dy, bin, quota, n = 0, cut, above, i, j;
     const int floor_bin = score_floor(level) / 2;
-    memset(hist, 0, sizeof hist);
+    memset(hist4, 0, sizeof hist4);
     /* pass 1: best key (score << 4 | offset) of every block, histogram of score bins */
     for (by = 0; by < bh; by++) {
         int rows = 0;
@@ -180,14 +181,28 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
             if (y < 1 || y > h - 2) continue;
             rk->select_keys(img + (ptrdiff_t)y * w, w, w, b, dy, keys, rows++ > 0);
         }
-        for (bx = 0; bx < bw; bx++) {
-            int best = 0;
-            if (rows)
-                for (x = bx * b; x < bx * b + b && x < w; x++) best = keys[x] > best ? keys[x] : best;
+        if (!rows) memset(keys, 0, (size_t)w * sizeof *keys);
+        for (bx = 0; bx < w / b; bx++) {   /* whole blocks */
+            const int16_t *k = keys + bx * b;
+            int best = k[0];
+            if (b > 1) best = k[1] > best ? k[1] : best;
+            if (b > 2) {
+                best = k[2] > best ? k[2] : best;
+                best = k[3] > best ? k[3] : best;
+            }
             cells[by * bw + bx] = (uint16_t)best;
-            hist[best >> 5 > 255 ? 255 : best >> 5]++;   /* bin = score / 2 */
+            /* bin = score / 2; four interleaved histograms: flat runs hit one bin, and one
+             * counter would serialise on its own increments */
+            hist4[bx & 3][best >> 5 > 255 ? 255 : best >> 5]++;
+        }
+        for (; bx < bw; bx++) {             /* a partial block at the right edge */
+            int best = 0;
+            for (x = bx * b; x < w; x++) best = keys[x] > best ? keys[x] : best;
+            cells[by * bw + bx] = (uint16_t)best;
+            hist4[0][best >> 5 > 255 ? 255 : best >> 5]++;
         }
     }
+    for (i = 0; i < 256; i++) hist[i] = hist4[0][i] + hist4[1][i] + hist4[2][i] + hist4[3][i];
     /* the lowest bin that still fits the capacity, not below the floor */
     above = 0;
     for (cut = 255; cut > floor_bin; cut--) {
@@ -197,27 +212,30 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
     quota = out->capacity - above;
     /* pass 2: every block above the cut bin, and of the cut bin an evenly spread quota (the
      * j-th of its members when j * quota / count steps), so no image region is favoured */
-    for (i = 0, j = 0; i < n_blocks; i++) {
-        const int key = cells[i];
-        const uint8_t *p;
-        bin = key >> 5 > 255 ? 255 : key >> 5;
-        if (bin < cut) continue;
-        if (bin == cut) {
-            long before = (long)j * quota / hist[cut], after = (long)(j + 1) * quota / hist[cut];
-            j++;
-            if (after == before) continue;
+    for (by = 0, i = 0, j = 0; by < bh; by++) {
+        for (bx = 0; bx < bw; bx++, i++) {
+            /* branch-free compaction: always write, advance only when kept (the arrays have
+             * a lane of slack); only the cut bin's members take a branch */
+            const int key = cells[i];
+            int keep;
+            bin = key >> 5 > 255 ? 255 : key >> 5;
+            keep = bin > cut;
+            if (bin == cut) {
+                keep = (long)(j + 1) * quota / hist[cut] != (long)j * quota / hist[cut];
+                j++;
+            }
+            out->x[n] = (int16_t)(bx * b + (key & (b - 1)));
+            out->y[n] = (int16_t)(by * b + ((key & 15) >> log2b));
+            n += keep;
         }
-        x = (i % bw) * b + (key & 15) % b;
-        y = (i / bw) * b + (key & 15) / b;
-        p = img + (ptrdiff_t)y * w + x;
-        out->x[n] = (int16_t)x;
-        out->y[n] = (int16_t)y;
-        out->t[n] = (int16_t)p[0];
-        out->gx[n] = (int16_t)(p[1] - p[-1]);
-        out->gy[n] = (int16_t)(p[w] - p[-w]);
-        n++;
     }
     out->n = n;
+    for (i = 0; i < n; i++) {
+        const uint8_t *p = img + (ptrdiff_t)out->y[i] * w + out->x[i];
+        out->t[i] = (int16_t)p[0];
+        out->gx[i] = (int16_t)(p[1] - p[-1]);
+        out->gy[i] = (int16_t)(p[w] - p[-w]);
+    }
     /* pad to whole lanes with inert points (zero gradient, zero weight at match time) */
     for (; n % LANES; n++) out->x[n] = out->y[n] = out->t[n] = out->gx[n] = out->gy[n] = 0;
 }
@@ -237,7 +255,7 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
         st->rk->downsample(st->pyr[l - 1], st->w[l - 1], st->pyr[l], st->w[l], st->w[l], st->h[l]);
     /* the id is a hash of the data: the same frame gets the same id, so outputs stay
      * deterministic, and features are tied to the snapshot they were extracted with */
-    l = st->levels > 1 ? 1 : 0;
+    l = st->levels - 1;
     st->pyr_id = hash_bytes(st->pyr[l], (size_t)st->w[l] * (size_t)st->h[l]);
     slot = st->next_slot;
     st->next_slot ^= 1;
@@ -357,38 +375,36 @@ static double robust_sigma(const float *img_b, const int16_t *t, int n, double a
     }
 }
 
-/* Cauchy weight and cost at scale c: the influence of a residual fades as 1/|r| far out, so
- * occluders and moving objects barely pull, yet no point is ever cut off outright. */
-static double robust_weight(double r, double c)
-{
-    double q = r / c;
-    return 1.0 / (1.0 + q * q);
-}
-
+/* The acceptance test's error per point: Geman-McClure, bounded like the Cauchy weights'
+ * influence and made of IEEE operations only (no libm), so every platform decides alike. */
 static double robust_cost(double r, double c)
 {
     double q = r / c;
-    return 0.5 * c * c * log(1.0 + q * q);
+    return 0.5 * r * r / (1.0 + q * q);
 }
 
-/* Weighted least-squares gain and bias of alpha * B + beta ~ A with Cauchy weights at scale
+/* Weighted least-squares gain and bias of alpha * B + beta ~ A with Cauchy weights
+ * 1 / (1 + (r / c)^2), c = 2.385 sigma: the influence of a residual fades as 1 / |r| far out, so
+ * occluders and moving objects barely pull, yet no point is ever cut off outright. Scale
  * sigma from the residuals of the current (alpha, beta); writes weights and new residuals.
  * mask (optional): only points valid there too. Returns the number of valid points. */
 static int fit_photometric(solver *s, const home__refine_points *tp, const float *img_b,
                            const float *mask, double sigma, float *res, float *wt)
 {
-    const double c = CAUCHY_K * sigma;
+    const float inv_c = (float)(1.0 / (CAUCHY_K * sigma));
+    const float alpha = (float)s->alpha, beta = (float)s->beta;
     double sw = 0, sb = 0, sa = 0, sbb = 0, sab = 0, den;
     int i, n = 0;
+    /* branch-free: invalid points get weight 0 and add nothing */
     for (i = 0; i < tp->n; i++) {
-        double r, w, b;
-        if (img_b[i] < 0.0f || (mask && mask[i] < 0.0f)) { wt[i] = 0.0f; continue; }
-        b = img_b[i];
-        r = s->alpha * b + s->beta - tp->t[i];
-        w = robust_weight(r, c);
-        wt[i] = (float)w;
-        sw += w; sb += w * b; sa += w * tp->t[i]; sbb += w * b * b; sab += w * b * tp->t[i];
-        n++;
+        const int ok = img_b[i] >= 0.0f && (!mask || mask[i] >= 0.0f);
+        const float b = ok ? img_b[i] : 0.0f, a = (float)tp->t[i];
+        const float q = (alpha * b + beta - a) * inv_c;
+        const float w = ok ? 1.0f / (1.0f + q * q) : 0.0f;
+        const double wb = (double)w * b;
+        wt[i] = w;
+        sw += w; sb += wb; sa += (double)w * a; sbb += wb * b; sab += wb * a;
+        n += ok;
     }
     if (n && sw > 0) {
         den = sw * sbb - sb * sb;
@@ -400,8 +416,11 @@ static int fit_photometric(solver *s, const home__refine_points *tp, const float
             s->beta = (sa - sb) / sw;
         }
     }
-    for (i = 0; i < tp->n; i++)
-        res[i] = wt[i] > 0.0f ? (float)(s->alpha * img_b[i] + s->beta - tp->t[i]) : 0.0f;
+    {
+        const float a2 = (float)s->alpha, b2 = (float)s->beta;
+        for (i = 0; i < tp->n; i++)
+            res[i] = wt[i] > 0.0f ? a2 * img_b[i] + b2 - (float)tp->t[i] : 0.0f;
+    }
     for (; i < ((tp->n + LANES - 1) & ~(LANES - 1)); i++) res[i] = wt[i] = 0.0f;
     return n;
 }
@@ -524,21 +543,16 @@ static double corner_std_px(const solver *s)
     return worst;
 }
 
-/* Robust photometric error of hn at the finest level over the points valid under both hn and
- * other_b (B samples under the other estimate): mean Cauchy cost at the fixed scale sigma, after
- * re-fitting gain and bias. Also the weighted correlation of A and B there. */
-static double photometric_error(solver *s, const double *hn, const float *other_b, double sigma,
-                                float *img_b, double *zncc)
+/* Robust photometric error of the finest-level B samples img_b over the points other_b (the
+ * samples under the other estimate) keeps too: mean robust cost at the fixed scale sigma,
+ * after re-fitting gain and bias. Also the weighted correlation of A and B there. */
+static double photometric_error(solver *s, const float *img_b, const float *other_b,
+                                double sigma, double *zncc)
 {
-    const home__refine_state *st = s->st;
     const home__refine_points *tp = &s->tpl[0];
-    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
     const double c = CAUCHY_K * sigma;
     double cost = 0, sw = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, va, vb;
-    float m[9];
     int i, it, n = 0;
-    level_matrix(s, hn, 0, m);
-    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], img_b);
     s->alpha = 1.0;
     s->beta = 0.0;
     for (it = 0; it < 3; it++) fit_photometric(s, tp, img_b, other_b, sigma, s->res, s->wt);
@@ -627,22 +641,18 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     /* like for like: both estimates over the points both keep, at the scale of HOME's */
     {
         const home__refine_points *tp = &s.tpl[0];
+        const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
         float m[9];
         level_matrix(&s, s.hn, 0, m);
-        st->rk->warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
-                          st->w[0], st->w[0], st->h[0], s.img_b2);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], s.img_b2);
         level_matrix(&s, hn0, 0, m);
-        st->rk->warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
-                          st->w[0], st->w[0], st->h[0], s.img_b);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], s.img_b);
         s.alpha = 1.0;
         s.beta = 0.0;
         fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
         sigma0 = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta);
-        e0 = photometric_error(&s, hn0, s.img_b2, sigma0, s.img_b, &zncc0);
-        level_matrix(&s, hn0, 0, m);
-        st->rk->warp(m, tp->x, tp->y, (tp->n + LANES - 1) & ~(LANES - 1), st->pyr[0],
-                          st->w[0], st->w[0], st->h[0], s.img_b2);
-        e1 = photometric_error(&s, s.hn, s.img_b2, sigma0, s.img_b, &zncc1);
+        e0 = photometric_error(&s, s.img_b, s.img_b2, sigma0, &zncc0);
+        e1 = photometric_error(&s, s.img_b2, s.img_b, sigma0, &zncc1);
     }
     result->refine_error[0] = e0;
     result->refine_error[1] = e1;

@@ -1,8 +1,9 @@
 /* Per-frame cost of the photometric refinement in the video case (extract the new frame, match
  * it against the previous one), side by side with HOME alone in the same run, per SIMD backend.
- *   home-bench-refine [--frames N] [--kind structured|weak] [--width W --height H]
+ *   home-bench-refine [--frames N] [--kind structured|weak] [--width W --height H] [--levels N]
  * Frames: a procedural scene under a slow random homography walk (corners move <= 4 px a frame),
- * noise sigma 2.5. Prints median ms per frame of HOME (refinement off), of the refinement
+ * noise sigma 2.5. Times are this thread's CPU time (robust to other load on the machine), so
+ * they are comparable between runs on a shared box. Prints median ms per frame of HOME (refinement off), of the refinement
  * stage (snapshot of the new frame + Gauss-Newton), the accept count and the mean corner error
  * of both against the true frame-to-frame homography. */
 #define _POSIX_C_SOURCE 200809L
@@ -17,7 +18,7 @@ static double clock_ms(void *user)
 {
     struct timespec ts;
     (void)user;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
@@ -38,7 +39,7 @@ int main(int argc, char **argv)
 {
     static const int simds[3] = {HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_NEON};
     static const char *names[3] = {"none", "sse", "neon"};
-    int frames = 30, width = 640, height = 360, i, f, s, k;
+    int frames = 30, width = 640, height = 360, levels = -1, i, f, s, k;
     enum synth_kind kind = SYNTH_STRUCTURED;
     uint8_t *img[2];
     double *pose, *home_ms, *ref_ms, *snap_ms;
@@ -46,6 +47,7 @@ int main(int argc, char **argv)
         if (!strcmp(argv[i], "--frames")) frames = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--width")) width = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--height")) height = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--levels")) levels = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--kind")) kind = !strcmp(argv[i + 1], "weak") ? SYNTH_WEAK_TEXTURE : SYNTH_STRUCTURED;
         else { fprintf(stderr, "home-bench-refine: unknown option %s\n", argv[i]); return 2; }
     }
@@ -80,11 +82,12 @@ int main(int argc, char **argv)
             static home_features feat[2];
             void *mem;
             size_t bytes;
-            int accepted = 0;
+            int accepted = 0, iterations = 0;
             double err = 0.0;
             home_default_config(&cfg, width, height);
             cfg.simd = simds[s];
             cfg.clock = clock_ms;
+            if (levels >= 0) cfg.refine_levels = levels;
             if (!k) cfg.refine_levels = 0;
             bytes = home_arena_size(&cfg);
             mem = malloc(bytes + HOME_ARENA_ALIGN);
@@ -102,6 +105,7 @@ int main(int argc, char **argv)
                 ref_ms[f - 1] = res.ms[HOME_STAGE_REFINE];
                 snap_ms[f - 1] = feat[f & 1].ms_refine;
                 accepted += res.refined;
+                iterations += res.refine_iterations;
                 synth_invert(pose + 9 * (f - 1), inv);
                 mul3(pose + 9 * f, inv, h_rel);
                 err += synth_corner_error(res.H, h_rel, width, height);
@@ -114,9 +118,10 @@ int main(int argc, char **argv)
                        home_ms[(frames - 1) / 2], err / (frames - 1));
             else
                 printf("%-5s HOME + refinement: HOME %7.3f + refine %.3f ms/frame (snapshot %.3f, "
-                       "solve %.3f), accepted %d/%d, error %.4f px\n", names[s],
+                       "solve %.3f), %.1f iterations, accepted %d/%d, error %.4f px\n", names[s],
                        home_ms[(frames - 1) / 2], ref_ms[(frames - 1) / 2], snap_ms[(frames - 1) / 2],
-                       ref_ms[(frames - 1) / 2] - snap_ms[(frames - 1) / 2], accepted, frames - 1,
+                       ref_ms[(frames - 1) / 2] - snap_ms[(frames - 1) / 2],
+                       (double)iterations / (frames - 1), accepted, frames - 1,
                        err / (frames - 1));
             free(mem);
         }
