@@ -5,13 +5,38 @@
 #include "stab_warp.h"
 #include <math.h>
 
+/* Inner loop for a row whose every sample lies inside [0, w-1) x [0, h-1): no clamping. Gives
+ * the same bytes as the clamped loop there (xi = x >> 16 <= w - 2 already). */
+static void warp_row_inside(const uint8_t *src, ptrdiff_t stride, int step, int32_t x, int32_t y,
+                            int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
+{
+    int i;
+    for (i = 0; i < n; i++, x += dx, y += dy) {
+        const uint8_t *p = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride + (ptrdiff_t)(x >> HOME__WARP_FRAC_BITS) * step;
+        const uint32_t fx = (uint32_t)(((x & 0xffff) + 128) >> 8), fy = (uint32_t)(((y & 0xffff) + 128) >> 8);
+        const uint32_t top = p[0] * (256 - fx) + p[step] * fx;
+        const uint32_t bot = p[stride] * (256 - fx) + p[stride + step] * fx;
+        dst[(ptrdiff_t)i * dst_step] = (uint8_t)((top * (256 - fy) + bot * fy + 32768u) >> 16);
+    }
+}
+
 void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                       int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
     const int32_t x_max = (int32_t)(w - 1) << HOME__WARP_FRAC_BITS;
     const int32_t y_max = (int32_t)(h - 1) << HOME__WARP_FRAC_BITS;
+    const int64_t x1 = (int64_t)x0 + (int64_t)dx * (n - 1), y1 = (int64_t)y0 + (int64_t)dy * (n - 1);
     int32_t x = x0, y = y0;
     int i;
+    if (n <= 0) return;
+    /* affine: the row's extremes are its ends */
+    if (x0 >= 0 && x0 < x_max && x1 >= 0 && x1 < x_max && y0 >= 0 && y0 < y_max && y1 >= 0 && y1 < y_max) {
+        if (step == 1 && dst_step == 1)   /* planar: constant steps let the compiler do better */
+            warp_row_inside(src, stride, 1, x0, y0, dx, dy, dst, 1, n);
+        else
+            warp_row_inside(src, stride, step, x0, y0, dx, dy, dst, dst_step, n);
+        return;
+    }
     for (i = 0; i < n; i++, x += dx, y += dy) {
         /* clamp into the plane; at the last column/row use the pair (w-2, w-1) with weight 256 */
         int32_t xc = x < 0 ? 0 : x > x_max ? x_max : x;
@@ -98,6 +123,8 @@ static int check_image(const home_stab_image *im)
     for (k = 0; k < planes; k++) {
         if (!im->plane[k]) return HOME_E_NULL;
         if (im->stride[k] < row_bytes[k]) return HOME_E_STRIDE;
+        /* the last row's address must not overflow (checked for the luma's row count) */
+        if (im->stride[k] > (PTRDIFF_MAX - row_bytes[k]) / (im->height - 1)) return HOME_E_STRIDE;
     }
     return HOME_OK;
 }
