@@ -10,6 +10,7 @@
 #include "pgm.h"
 #include "synth.h"
 #include "y4m.h"
+#include "home_stab.h"
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
@@ -29,6 +30,12 @@ static uint8_t img_a[W * H], img_b[W * H], img_other[(W + 32) * H], hough[1 << 1
 static union { unsigned char bytes[4u << 20]; double align; } arena, arena_other;
 static union { unsigned char bytes[256]; double align; } junk;
 static size_t needed;
+static home_stab_config scfg, sbad;
+static home_stab *stab;
+static home_stab_image sframe, sdst;
+static home_stab_output sout;
+static union { unsigned char bytes[8u << 20]; double align; } stab_arena;
+static double warp_m[9];
 static float col, row;
 static double h_init[9];
 static int hw, hh;
@@ -53,6 +60,29 @@ static void fixture(void)
     memset(junk.bytes, 0x5a, sizeof junk.bytes);
     memset(h_init, 0, sizeof h_init);
     h_init[0] = h_init[4] = h_init[8] = 1.0;
+    memcpy(warp_m, h_init, sizeof warp_m);
+    home_stab_default_config(&scfg, W, H);
+    sbad = scfg;
+    stab = NULL;
+    if (home_stab_init(&stab, &scfg, stab_arena.bytes, sizeof stab_arena.bytes, NULL) != HOME_OK) ctx = NULL;
+    memset(&sframe, 0, sizeof sframe);
+    sframe.format = HOME_STAB_GREY;
+    sframe.width = W;
+    sframe.height = H;
+    sframe.plane[0] = img_a;
+    sframe.stride[0] = W;
+    sdst = sframe;
+    sdst.plane[0] = img_b;
+}
+
+/* a 4:2:0 frame whose chroma planes point into img_b */
+static int push_i420(int drop_chroma)
+{
+    sframe.format = HOME_STAB_I420;
+    sframe.plane[1] = drop_chroma ? NULL : img_b;
+    sframe.plane[2] = img_b + W * H / 4;
+    sframe.stride[1] = sframe.stride[2] = W / 2;
+    return home_stab_push(stab, &sframe, &sout);
 }
 
 /* features of another context: a frame of another size, or another config of the same size */
@@ -199,6 +229,25 @@ static int y4m(const char *text, size_t size, int frames)
     X(refine_zero_h22, HOME_E_CONFIG, (h_init[8] = 0.0, home_refine(ctx, img_a, W, img_b, W, h_init, &res))) \
     X(refine_stride_a_below_width, HOME_E_STRIDE, home_refine(ctx, img_a, 1, img_b, W, h_init, &res)) \
     X(refine_uninitialised_context, HOME_E_STATE, home_refine((home_context *)(void *)junk.bytes, img_a, W, img_b, W, h_init, &res)) \
+    /* stabiliser (home_stab_*) */ \
+    X(stab_config_null, HOME_E_NULL, home_stab_default_config(NULL, W, H)) \
+    X(stab_odd_width, HOME_E_SIZE, (sbad.width = W + 1, home_stab_validate_config(&sbad))) \
+    X(stab_margin_nan, HOME_E_CONFIG, (sbad.margin = (float)NAN, home_stab_validate_config(&sbad))) \
+    X(stab_lookahead_above_max, HOME_E_CONFIG, (sbad.lookahead = HOME_STAB_MAX_LOOKAHEAD + 1, home_stab_validate_config(&sbad))) \
+    X(stab_arena_one_byte_short, HOME_E_ARENA_SMALL, home_stab_init(&stab, &scfg, stab_arena.bytes, home_stab_arena_size(&scfg) - 1, NULL)) \
+    X(stab_push_null_frame, HOME_E_NULL, home_stab_push(stab, NULL, &sout)) \
+    X(stab_push_frame_of_other_size, HOME_E_MISMATCH, (sframe.height = H - 2, home_stab_push(stab, &sframe, &sout))) \
+    X(stab_push_stride_below_width, HOME_E_STRIDE, (sframe.stride[0] = W - 1, home_stab_push(stab, &sframe, &sout))) \
+    X(stab_push_unknown_format, HOME_E_CONFIG, (sframe.format = 0, home_stab_push(stab, &sframe, &sout))) \
+    X(stab_push_odd_width_i420, HOME_E_SIZE, (sframe.width = W - 1, push_i420(0))) \
+    X(stab_push_missing_chroma_plane, HOME_E_NULL, push_i420(1)) \
+    X(stab_push_uninitialised, HOME_E_STATE, home_stab_push((home_stab *)(void *)junk.bytes, &sframe, &sout)) \
+    X(stab_flush_null_output, HOME_E_NULL, home_stab_flush(stab, NULL)) \
+    X(stab_warp_projective, HOME_E_CONFIG, (warp_m[6] = 1e-3, home_stab_warp(warp_m, &sframe, &sdst))) \
+    X(stab_warp_nan, HOME_E_CONFIG, (warp_m[2] = NAN, home_stab_warp(warp_m, &sframe, &sdst))) \
+    X(stab_warp_far_outside, HOME_E_CONFIG, (warp_m[2] = 10.0 * W, home_stab_warp(warp_m, &sframe, &sdst))) \
+    X(stab_warp_format_mismatch, HOME_E_MISMATCH, (sdst.format = HOME_STAB_YUYV, sdst.stride[0] = 2 * W, home_stab_warp(warp_m, &sframe, &sdst))) \
+    X(stab_warp_stride_overflows, HOME_E_STRIDE, (sframe.stride[0] = PTRDIFF_MAX / 2, home_stab_warp(warp_m, &sframe, &sdst))) \
     /* inspection */ \
     X(hough_size_null_output, HOME_E_NULL, home_hough_size(ctx, &hw, NULL)) \
     X(render_hough_null_output, HOME_E_NULL, home_render_hough(ctx, img_a, W, NULL, 1024)) \
