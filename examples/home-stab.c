@@ -28,6 +28,7 @@ static void usage(FILE *f)
             "  --lookahead N     frames of latency for fixed-lag smoothing (default 0)\n"
             "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 480 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
+            "  --no-refine       skip HOME's photometric refinement of each registration\n"
             "  --side-by-side    write original | stabilised, twice as wide\n"
             "  --csv FILE        per-frame raw and smoothed camera path\n"
             "  --plot FILE.png   plot of the raw and smoothed path\n"
@@ -122,7 +123,7 @@ int main(int argc, char **argv)
     void *arena = NULL;
     FILE *in;
     char err[256];
-    int i, status, rc = 0, got;
+    int i, status, rc = 0, got, refine = 1;
     long frames = 0, failed = 0;
     size_t need;
 
@@ -133,6 +134,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--help")) { usage(stdout); return 0; }
         if (!strcmp(a, "--side-by-side")) { ap.side_by_side = 1; continue; }
         if (!strcmp(a, "--quiet")) { ap.quiet = 1; continue; }
+        if (!strcmp(a, "--no-refine")) { refine = 0; continue; }
         if (!strcmp(a, "-") || a[0] != '-') {
             if (!in_path) in_path = a;
             else if (!out_path) out_path = a;
@@ -166,6 +168,7 @@ int main(int argc, char **argv)
     cfg.lookahead = (int)lookahead;
     if (downscale > 0) cfg.downscale = (int)downscale;
     cfg.keypoints_per_sign = (int)keypoints;
+    cfg.refine = refine;
     cfg.clock = now_ms;
     if (status == HOME_OK) status = home_stab_validate_config(&cfg);
     if (status != HOME_OK) {

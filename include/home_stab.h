@@ -61,6 +61,8 @@ typedef struct home_stab_config {
     int downscale;            /* register on luma box-averaged by 1, 2 or 4 */
     int keypoints_per_sign;   /* HOME's budget per frame (see home_config) */
     int min_inliers;          /* HOME's failure rule (see home_config) */
+    int refine;               /* 1: HOME's photometric refinement of each H (home_config's
+                                 refine_levels default), 0: off */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
     float max_rotation;       /* plausible per-frame rotation, radians */
     float max_zoom;           /* plausible per-frame |log scale| */
@@ -100,7 +102,7 @@ typedef struct home_stab_output {
 typedef struct home_stab home_stab;
 
 /* Defaults for a width x height stream: margin 0.10, smoothing 15, lookahead 0, downscale 2
- * for frames wider than 480 px (else 1), 500 keypoints per sign. */
+ * for frames wider than 480 px (else 1), 500 keypoints per sign, refinement on. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

@@ -50,6 +50,7 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
     cfg->downscale = width > 480 ? 2 : 1;
     cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 500 ? HOME_MAX_KEYPOINTS_PER_SIGN : 500;
     cfg->min_inliers = 20;
+    cfg->refine = 1;
     cfg->max_shift = 0.15f;
     cfg->max_rotation = 0.15f;
     cfg->max_zoom = 0.10f;
@@ -66,6 +67,7 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
     if (status != HOME_OK) return status;
     h->keypoints_per_sign = cfg->keypoints_per_sign;
     h->min_inliers = cfg->min_inliers;
+    if (!cfg->refine) h->refine_levels = 0;
     h->clock = cfg->clock;
     h->clock_user = cfg->clock_user;
     return home_validate_config(h);
@@ -79,7 +81,7 @@ int home_stab_validate_config(const home_stab_config *cfg)
         cfg->height > HOME_MAX_SIDE || cfg->width % 2 || cfg->height % 2)
         return HOME_E_SIZE;
     if (!is_finite_in(cfg->margin, 0.0, 0.4) || !is_finite_in(cfg->smoothing, 1.0, 1000.0) ||
-        cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD ||
+        cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD || (cfg->refine != 0 && cfg->refine != 1) ||
         !is_finite_in(cfg->max_shift, 0.0, 1.0) || !is_finite_in(cfg->max_rotation, 0.0, 1.6) ||
         !is_finite_in(cfg->max_zoom, 0.0, 1.0) || !is_finite_in(cfg->max_residual, 0.0, 1e6))
         return HOME_E_CONFIG;
