@@ -93,7 +93,7 @@ int home__lm_solve(double *p, int n, const int *index, home__residual_fn fn, con
                     memcpy(p, trial, sizeof trial);
                     lambda = lambda * 0.1 < 1e-12 ? 1e-12 : lambda * 0.1;
                     improved = 1;
-                    if (gain <= 1e-12 * cost) return 1; /* converged */
+                    if (gain <= 1e-8 * cost) return 1; /* converged: far below bin precision */
                     cost = new_cost;
                     break;
                 }
