@@ -165,7 +165,7 @@ enum home_refine_status {
     HOME_REFINE_NO_SNAPSHOT,      /* a is not in the context's last two extracted frames, or b
                                      is not the last one (see home_match) */
     HOME_REFINE_FEW_POINTS,       /* too little texture: fewer than 64 usable template points */
-    HOME_REFINE_NOT_CONVERGED,    /* the finest level hit refine_iterations */
+    HOME_REFINE_NOT_CONVERGED,    /* the finest level used hit refine_iterations */
     HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above 0.5 px (predicted, or from
                                      two interleaved halves of the points) */
     HOME_REFINE_OUTSIDE_TRUST,    /* a corner moved more than refine_trust_px from HOME's H */

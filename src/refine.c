@@ -12,7 +12,10 @@
  * resolution, 2x2, 1x1) whose score clears a camera-noise floor, strongest first up to
  * HOME_REFINE_MAX_POINTS >> level. Flat regions contribute nothing to LK but time.
  *
- * Safeguards (result.refine_status): the refined H replaces HOME's only if the finest level
+ * The estimate ends at full resolution, or at the finest level with at least 512 template
+ * points (faint texture leaves few points above the noise floor at full resolution).
+ *
+ * Safeguards (result.refine_status): the refined H replaces HOME's only if that finest level
  * converged within its cap, the estimate is well conditioned (the corners' standard deviation
  * predicted by the Fisher information, and the disagreement of two interleaved halves of the
  * points, which also sees noise in the template's own gradients, both under 0.5 px), no corner
@@ -32,6 +35,8 @@
 #define CAUCHY_K 2.385     /* 95 % efficiency at Gaussian noise */
 #define SIGMA_FLOOR 0.5     /* grey levels: the residual scale never collapses below this */
 #define MIN_POINTS 64       /* fewer usable template points at a level: textureless, decline */
+#define FINEST_MIN_POINTS 512 /* the level the estimate ends at needs this many points, else the
+                                 next coarser one is the finest (faint texture: less noise there) */
 #define STEP_EPS_PX 0.01    /* convergence: largest corner update, full-resolution px */
 #define MAX_CORNER_STD_PX 0.5 /* corner standard deviation (Fisher or split-half) above this:
                                  ill conditioned */
@@ -278,6 +283,7 @@ typedef struct solver {
     double jtj[64];                     /* last weighted normal matrix (normalised units) */
     double resid_var;                   /* weighted residual variance of the last iteration */
     double split_px;                    /* split-half disagreement of the last finest step */
+    int finest;                         /* level the estimate ends at */
     float *img_b, *img_b2, *res, *wt;   /* per-point scratch */
 } solver;
 
@@ -483,7 +489,7 @@ static int iterate(solver *s, int level, double *step_px)
     st->rk->accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff, acc);
     normal_equations(acc, 0xf, k, a, g);
     memcpy(s->jtj, a, sizeof a);
-    if (level == 0) {
+    if (level == s->finest) {
         /* split-half check: the steps of the even and the odd lanes (interleaved halves of the
          * points) from the same estimate agree when the points carry signal and scatter when
          * they carry template noise, which the Fisher covariance cannot see */
@@ -549,7 +555,7 @@ static double corner_std_px(const solver *s)
 static double photometric_error(solver *s, const float *img_b, const float *other_b,
                                 double sigma, double *zncc)
 {
-    const home__refine_points *tp = &s->tpl[0];
+    const home__refine_points *tp = &s->tpl[s->finest];
     const double c = CAUCHY_K * sigma;
     double cost = 0, sw = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, va, vb;
     int i, it, n = 0;
@@ -612,10 +618,12 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     s.alpha = 1.0;
     to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
-    for (level = 0; level < st->levels; level++) {
+    for (s.finest = 0; s.finest < st->levels - 1; s.finest++)
+        if (s.tpl[s.finest].n >= FINEST_MIN_POINTS) break;
+    for (level = s.finest; level < st->levels; level++) {
         if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return; }
     }
-    for (level = st->levels - 1; level >= 0; level--) {
+    for (level = st->levels - 1; level >= s.finest; level--) {
         converged = 0;
         for (it = 0; it < ctx->cfg.refine_iterations; it++) {
             iterations++;
@@ -640,13 +648,14 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     }
     /* like for like: both estimates over the points both keep, at the scale of HOME's */
     {
-        const home__refine_points *tp = &s.tpl[0];
+        const int fl = s.finest;
+        const home__refine_points *tp = &s.tpl[fl];
         const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
         float m[9];
-        level_matrix(&s, s.hn, 0, m);
-        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], s.img_b2);
-        level_matrix(&s, hn0, 0, m);
-        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[0], st->w[0], st->w[0], st->h[0], s.img_b);
+        level_matrix(&s, s.hn, fl, m);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
+        level_matrix(&s, hn0, fl, m);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
         s.alpha = 1.0;
         s.beta = 0.0;
         fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
