@@ -442,7 +442,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
         if (status != HOME_OK) return status;
         out->newest_status = HOME_STAB_MOTION_FAILED;
         if (out->reg.ok) {
-            home_stab_sim s;
+            home_stab_sim s = {0, 0, 0, 0}; /* fit_similarity() fills it when it returns >= 0 */
             double res = fit_similarity(st, out->reg.H, &s);
             out->newest_status = HOME_STAB_MOTION_IMPLAUSIBLE;
             if (res >= 0.0 && res <= st->cfg.max_residual &&
