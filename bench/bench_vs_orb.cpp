@@ -32,12 +32,22 @@ static double median(std::vector<double> v) {
 
 struct HomeTimes { double frame, stage[HOME_STAGE_COUNT], pair_total; double err; size_t arena; };
 
-static bool time_home(int simd, int refine, int w, int h, const std::vector<uint8_t> &a,
+// preset 0: defaults with refinement; 1: defaults without; 2: video preset for small cores
+// (Hough of the 2x2-downscaled frame, theta-window motion prior 27 bins, first threshold 16,
+// refinement on)
+static const char *preset_name[] = {"default", "no-refine", "video"};
+
+static bool time_home(int simd, int preset, int w, int h, const std::vector<uint8_t> &a,
                       const std::vector<uint8_t> &b, const double *truth, int runs, HomeTimes &out) {
     home_config cfg;
     home_default_config(&cfg, w, h);
     cfg.simd = simd;
-    if (!refine) cfg.refine_levels = 0;
+    if (preset == 1) cfg.refine_levels = 0;
+    if (preset == 2) {
+        cfg.hough_downscale = 2;
+        cfg.match_theta_window = 27;
+        cfg.threshold_start = 16;
+    }
     cfg.clock = now_ms;
     if (home_validate_config(&cfg) != HOME_OK) return false;
     out.arena = home_arena_size(&cfg);
@@ -164,15 +174,15 @@ int main(int argc, char **argv) {
         synth_render(SYNTH_STRUCTURED, 7, hb, 2.5, 2, b.data(), w, h, w);
         double orb_err, orb_ms = time_orb(w, h, a, b, hwarp, runs, orb_err);
         printf("== %dx%d   ORB frame: %.2f ms (corner error %.3f px)\n", w, h, orb_ms, orb_err);
-        printf("%-8s %-7s %8s %8s %6s | pair stages: %7s %7s %8s %6s %6s %6s %7s | %8s %6s\n", "backend",
-               "refine", "frame", "ORB/HOME", "err", "hough", "detect", "describe", "match", "homog",
+        printf("%-8s %-9s %8s %8s %6s | pair stages: %7s %7s %8s %6s %6s %6s %7s | %8s %6s\n", "backend",
+               "preset", "frame", "ORB/HOME", "err", "hough", "detect", "describe", "match", "homog",
                "refine", "total", "arena", "");
         for (auto &bk : backends)
-            for (int refine = 1; refine >= 0; refine--) {
+            for (int preset = 0; preset < 3; preset++) {
                 HomeTimes t;
-                if (!time_home(bk.simd, refine, w, h, a, b, hwarp, runs, t)) continue;
-                printf("%-8s %-7s %8.2f %8.2f %6.3f | %19.2f %7.2f %8.2f %6.2f %6.2f %6.2f %7.2f | %8zu\n",
-                       bk.name, refine ? "on" : "off", t.frame, orb_ms / t.frame, t.err,
+                if (!time_home(bk.simd, preset, w, h, a, b, hwarp, runs, t)) continue;
+                printf("%-8s %-9s %8.2f %8.2f %6.3f | %19.2f %7.2f %8.2f %6.2f %6.2f %6.2f %7.2f | %8zu\n",
+                       bk.name, preset_name[preset], t.frame, orb_ms / t.frame, t.err,
                        t.stage[HOME_STAGE_HOUGH], t.stage[HOME_STAGE_DETECT], t.stage[HOME_STAGE_DESCRIBE],
                        t.stage[HOME_STAGE_MATCH], t.stage[HOME_STAGE_HOMOGRAPHY], t.stage[HOME_STAGE_REFINE],
                        t.stage[HOME_STAGE_TOTAL], t.arena);
