@@ -14,8 +14,6 @@ FUZZ_REPLAY_OBJ := $(foreach t,$(FUZZ_TARGETS),$(BUILD)/obj/fuzz-replay/fuzz_$(t
 FUZZ_SUPPORT := $(SUPPORT_OBJ) $(BUILD)/obj/examples/y4m.o
 BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
 TEST_BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
-# `all` is declared before mk/*.mk are included, so BINS added here must be named explicitly
-all: $(HARD_TESTS) $(FUZZ_REPLAY)
 
 $(HARD_TESTS): $(HARD_TEST_OBJ) $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
@@ -79,8 +77,8 @@ stack:
 		--objdump $(CROSS_COMPILE)objdump $(STACK_BUILD)/obj
 
 # --- valgrind -----------------------------------------------------------------------------
-# The bad-input table, the must-fail pairs, the layout/arena determinism runs, the fuzz corpus
-# and the CLI on a small pair and on bad input (its exit 2 path frees everything too). The
+# The bad-input table, the must-fail pairs, the layout/arena determinism runs, the fuzz seeds and
+# regression inputs, and the CLI on a small pair and on bad input (its exit 2 path frees everything too). The
 # painted-stack test is left out: memcheck flags reads of a finished thread's stack.
 VALGRIND ?= valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=all \
 	--show-leak-kinds=all -q
@@ -88,7 +86,8 @@ VALGRIND_TESTS := bad_input_table refusals_leave_context_usable fails_constant_a
 	fails_single_edge fails_unrelated_scenes output_independent_of_arena_and_layout
 valgrind: all
 	$(VALGRIND) $(HARD_TESTS) $(VALGRIND_TESTS)
-	$(VALGRIND) $(FUZZ_REPLAY)
+	set -e; for t in $(FUZZ_TARGETS); do \
+		$(VALGRIND) $(FUZZ_REPLAY) $$t $$(ls tests/fuzz/corpus/$$t/seed-* tests/fuzz/corpus/$$t/regress-* 2> /dev/null) > /dev/null; done
 	@mkdir -p $(BUILD)/valgrind
 	$(BUILD)/bin/home-make-pair --width 160 --height 120 $(BUILD)/valgrind/a.pgm $(BUILD)/valgrind/b.pgm > /dev/null
 	$(VALGRIND) $(BUILD)/bin/home-register $(BUILD)/valgrind/a.pgm $(BUILD)/valgrind/b.pgm
