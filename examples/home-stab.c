@@ -29,6 +29,8 @@ static void usage(FILE *f)
             "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 480 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
+            "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
+            "                    its half-size copy (2: default from 320 px)\n"
             "  --side-by-side    write original | stabilised, twice as wide\n"
             "  --csv FILE        per-frame raw and smoothed camera path\n"
             "  --plot FILE.png   plot of the raw and smoothed path\n"
@@ -115,7 +117,7 @@ int main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
     home_stab_config cfg;
-    double margin = 0.10, smoothing = 15, lookahead = 0, downscale = 0, keypoints = 500;
+    double margin = 0.10, smoothing = 15, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0;
     double t_start, ms_reg = 0, ms_warp = 0, last_report;
     app ap;
     home_stab *stab = NULL;
@@ -148,6 +150,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--smoothing")) { target = &smoothing; lo = 1; hi = 1000; }
         else if (!strcmp(a, "--lookahead")) { target = &lookahead; lo = 0; hi = HOME_STAB_MAX_LOOKAHEAD; }
         else if (!strcmp(a, "--downscale")) { target = &downscale; lo = 1; hi = 4; }
+        else if (!strcmp(a, "--hough-downscale")) { target = &hough_ds; lo = 1; hi = 2; }
         else if (!strcmp(a, "--keypoints")) { target = &keypoints; lo = 16; hi = HOME_MAX_KEYPOINTS_PER_SIGN; }
         else { fprintf(stderr, "home-stab: unknown option %s (see --help)\n", a); return 2; }
         if (number(argv[++i], lo, hi, target)) {
@@ -169,6 +172,7 @@ int main(int argc, char **argv)
     if (downscale > 0) cfg.downscale = (int)downscale;
     cfg.keypoints_per_sign = (int)keypoints;
     cfg.refine = refine;
+    if (hough_ds > 0) cfg.hough_downscale = (int)hough_ds;
     cfg.clock = now_ms;
     if (status == HOME_OK) status = home_stab_validate_config(&cfg);
     if (status != HOME_OK) {

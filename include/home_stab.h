@@ -63,6 +63,10 @@ typedef struct home_stab_config {
     int min_inliers;          /* HOME's failure rule (see home_config) */
     int refine;               /* 1: HOME's photometric refinement of each H (home_config's
                                  refine_levels default), 0: off */
+    int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
+                                 2x2-box downscaled copy (2), see home_config */
+    int simd;                 /* enum home_simd for HOME and the warp (default: HOME_SIMD env or
+                                 the best compiled in) */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
     float max_rotation;       /* plausible per-frame rotation, radians */
     float max_zoom;           /* plausible per-frame |log scale| */
@@ -102,7 +106,8 @@ typedef struct home_stab_output {
 typedef struct home_stab home_stab;
 
 /* Defaults for a width x height stream: margin 0.10, smoothing 15, lookahead 0, downscale 2
- * for frames wider than 480 px (else 1), 500 keypoints per sign, refinement on. */
+ * for frames wider than 480 px (else 1), 500 keypoints per sign, refinement on, Hough on the
+ * half-size registration image from 320 px wide. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

@@ -5,7 +5,7 @@ STAB_SUPPORT := $(BUILD)/obj/examples/y4m.o $(BUILD)/obj/examples/stab_png.o $(B
 BINS += $(BUILD)/bin/home-stab $(BUILD)/bin/home-stab-clip $(BUILD)/bin/home-stab-tests
 TEST_BINS += $(BUILD)/bin/home-stab-tests
 
-$(BUILD)/obj/src/stabilise.o $(BUILD)/obj/src/warp.o: include/home_stab.h src/stab_warp.h
+$(BUILD)/obj/src/stabilise.o $(BUILD)/obj/src/warp.o $(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/stab_*.c)): include/home_stab.h port/stab_kernels.h
 
 $(BUILD)/bin/home-stab: $(BUILD)/obj/examples/home-stab.o $(STAB_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
@@ -16,9 +16,9 @@ $(BUILD)/bin/home-stab-clip: $(BUILD)/obj/examples/stab-make-clip.o $(STAB_SUPPO
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
 # tests/test_stab.c also lands in home-tests (tests/*.c), where it compiles to nothing.
-$(BUILD)/obj/tests/stab/test_stab.o: tests/test_stab.c include/home_stab.h src/stab_warp.h $(wildcard tests/*.h examples/*.h)
+$(BUILD)/obj/tests/stab/test_stab.o: tests/test_stab.c include/home_stab.h port/stab_kernels.h $(wildcard tests/*.h examples/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) -Isrc -DHOME_STAB_TESTS -c $< -o $@
+	$(CC) $(CFLAGS_APP) -Isrc -Iport -DHOME_STAB_TESTS -c $< -o $@
 
 $(BUILD)/bin/home-stab-tests: $(BUILD)/obj/tests/stab/test_stab.o $(STAB_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)

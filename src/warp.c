@@ -2,7 +2,7 @@
  * is converted once to Q16 integers, so every row's start and step are exact integers and the
  * output is the same bit for bit on every platform and in every kernel version. */
 #include "home_stab.h"
-#include "stab_warp.h"
+#include "stab_kernels.h"
 #include <math.h>
 
 /* Inner loop for a row whose every sample lies inside [0, w-1) x [0, h-1): no clamping. Gives
@@ -20,17 +20,24 @@ static void warp_row_inside(const uint8_t *src, ptrdiff_t stride, int step, int3
     }
 }
 
+int home__warp_row_inside(int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, int n)
+{
+    const int32_t x_max = (int32_t)(w - 1) << HOME__WARP_FRAC_BITS;
+    const int32_t y_max = (int32_t)(h - 1) << HOME__WARP_FRAC_BITS;
+    const int64_t x1 = (int64_t)x0 + (int64_t)dx * (n - 1), y1 = (int64_t)y0 + (int64_t)dy * (n - 1);
+    /* affine: the row's extremes are its ends */
+    return n > 0 && x0 >= 0 && x0 < x_max && x1 >= 0 && x1 < x_max && y0 >= 0 && y0 < y_max &&
+           y1 >= 0 && y1 < y_max;
+}
+
 void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                       int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
     const int32_t x_max = (int32_t)(w - 1) << HOME__WARP_FRAC_BITS;
     const int32_t y_max = (int32_t)(h - 1) << HOME__WARP_FRAC_BITS;
-    const int64_t x1 = (int64_t)x0 + (int64_t)dx * (n - 1), y1 = (int64_t)y0 + (int64_t)dy * (n - 1);
     int32_t x = x0, y = y0;
     int i;
-    if (n <= 0) return;
-    /* affine: the row's extremes are its ends */
-    if (x0 >= 0 && x0 < x_max && x1 >= 0 && x1 < x_max && y0 >= 0 && y0 < y_max && y1 >= 0 && y1 < y_max) {
+    if (home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
         if (step == 1 && dst_step == 1)   /* planar: constant steps let the compiler do better */
             warp_row_inside(src, stride, 1, x0, y0, dx, dy, dst, 1, n);
         else
@@ -55,6 +62,8 @@ void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int
         dst[(ptrdiff_t)i * dst_step] = (uint8_t)((top * (uint32_t)(256 - fy) + bot * (uint32_t)fy + 32768u) >> 16);
     }
 }
+
+const home__stab_kernels home__stab_kernels_scalar = {"none", home__warp_row_c};
 
 /* One component plane of a frame: where its samples are and how it is subsampled. */
 typedef struct plane_view {
@@ -136,6 +145,8 @@ static int32_t to_q16(double v) { return (int32_t)floor(v * 65536.0 + 0.5); }
 int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image *dst)
 {
     plane_view views[3];
+    const home__stab_kernels *kern;
+    home_config simd_choice;
     int status, n, k, j;
     double limit_x, limit_y;
     static const double corners[4][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
@@ -157,6 +168,10 @@ int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image 
         if (u < -limit_x + src->width || u > limit_x || v < -limit_y + src->height || v > limit_y)
             return HOME_E_CONFIG;
     }
+    /* the backend HOME would use (HOME_SIMD honoured); all give the same bytes */
+    home_default_config(&simd_choice, HOME_MIN_SIDE, HOME_MIN_SIDE);
+    kern = home__stab_kernels_for(simd_choice.simd);
+    if (!kern) kern = &home__stab_kernels_scalar;
     n = plane_views(src, dst, views);
     for (k = 0; k < n; k++) {
         const plane_view *p = &views[k];
@@ -167,8 +182,8 @@ int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image 
         const int32_t aq = to_q16(a), bq = to_q16(b), cq = to_q16(c);
         const int32_t dq = to_q16(d), eq = to_q16(e), fq = to_q16(f);
         for (j = 0; j < p->h; j++)
-            home__warp_row_c(p->src, p->src_stride, p->step, p->w, p->h, bq * j + cq, eq * j + fq,
-                             aq, dq, p->dst + (ptrdiff_t)j * p->dst_stride, p->step, p->w);
+            kern->warp_row(p->src, p->src_stride, p->step, p->w, p->h, bq * j + cq, eq * j + fq, aq,
+                           dq, p->dst + (ptrdiff_t)j * p->dst_stride, p->step, p->w);
     }
     return HOME_OK;
 }

@@ -17,7 +17,8 @@ Metrics, all on luma, computed the same way for every method from its output fra
   the output-to-input map M_t of each frame is found by aligning the output frame to the input
   frame t (Gauss-Newton similarity fit, coarse to fine); the output camera is then
   O_t = M_t^-1 G_t with G_t the true camera, and
-  jitter     px RMS of the high-frequency part of O_t (tx, ty, rotation x half diagonal): what a
+  jitter     px RMS (output pixels: a zoom magnifies it) of the high-frequency part of O_t (tx,
+             ty, rotation x half diagonal): what a
              centred Gaussian of sigma 4 frames leaves, 6 frames trimmed at each end
   ITF        mean over consecutive output frames of 10 log10(255^2 / MSE) over the pixels valid
              (inside the input) in both
@@ -25,12 +26,15 @@ Metrics, all on luma, computed the same way for every method from its output fra
              output path's per-frame translation and rotation, the smaller of the two
   crop       mean scale of M_t (1 = the full frame is shown); valid = mean share of output
              pixels inside the input (below 1: borders)
-  fps        frames / wall time of the whole process (both passes for vidstab)
+  fps        frames / wall time of the whole process (both passes for vidstab), and frames per
+             CPU second (user + system time of the process and all its threads: steadier on a
+             shared machine, and fair to multi-threaded filters)
 Usage: python3 bench/stab/compare.py [--quick] [--build build] [--frames N] [--out DIR]
 """
 import argparse
 import glob
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -50,11 +54,15 @@ PHOTOS = {
 
 
 def run(cmd, **kw):
+    """Run cmd; returns (wall seconds, CPU seconds of the process and its threads)."""
+    c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, **kw)
+    wall = time.perf_counter() - t0
+    c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if r.returncode != 0:
         sys.exit("failed: %s\n%s" % (" ".join(map(str, cmd)), r.stderr.decode(errors="replace")[-2000:]))
-    return time.perf_counter() - t0
+    return wall, (c1.ru_utime - c0.ru_utime) + (c1.ru_stime - c0.ru_stime)
 
 
 def photo_dir(cache):
@@ -292,25 +300,27 @@ def main():
             input_jitter.setdefault(cat, []).append(jitter(components(truth)))
             for mname, cmds in methods.items():
                 o = work / ("%s_%s.y4m" % (stem, mname.replace(" ", "_")))
-                wall = sum(run(cmd) for cmd in cmds(str(c), str(o)))
+                times = [run(cmd) for cmd in cmds(str(c), str(o))]
+                wall, cpu = sum(t[0] for t in times), sum(t[1] for t in times)
                 outs = read_y4m_luma(o)
                 if len(outs) != len(ins):
                     sys.exit("%s wrote %d frames of %d" % (mname, len(outs), len(ins)))
                 m = measure(outs, ins, truth)
                 m["fps"] = len(ins) / wall
+                m["cpu_fps"] = len(ins) / cpu
                 results.setdefault((cat, mname), []).append(m)
-                print("%-12s %-22s %-15s jitter %6.3f px  ITF %6.2f dB  stability %.3f  crop %.3f  valid %.3f  %6.1f fps" %
+                print("%-12s %-22s %-15s jitter %6.3f px  ITF %6.2f dB  stability %.3f  crop %.3f  valid %.3f  %6.1f fps (%.1f per CPU s)" %
                       (cat, Path(name).stem + (" a=%.1f" % decay if decay else ""), mname, m["jitter"], m["itf"],
-                       m["stability"], m["crop"], m["valid"], m["fps"]), flush=True)
+                       m["stability"], m["crop"], m["valid"], m["fps"], m["cpu_fps"]), flush=True)
 
     print("\n%d frames of %dx%d per clip; input jitter (px RMS):" % (frames, W, H),
           ", ".join("%s %.2f" % (c, np.mean(v)) for c, v in input_jitter.items()))
-    print("\n| category | method | jitter px | ITF dB | stability | crop | valid | fps |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("\n| category | method | jitter px | ITF dB | stability | crop | valid | fps (wall) | frames per CPU s |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for (cat, mname), ms in results.items():
         avg = {k: np.mean([m[k] for m in ms]) for k in ms[0]}
-        print("| %s | %s | %.3f | %.2f | %.3f | %.3f | %.3f | %.1f |" %
-              (cat, mname, avg["jitter"], avg["itf"], avg["stability"], avg["crop"], avg["valid"], avg["fps"]))
+        print("| %s | %s | %.3f | %.2f | %.3f | %.3f | %.3f | %.1f | %.1f |" %
+              (cat, mname, avg["jitter"], avg["itf"], avg["stability"], avg["crop"], avg["valid"], avg["fps"], avg["cpu_fps"]))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,51 @@
+/* Kernels of the stabiliser's warp (src/warp.c): one table per SIMD backend, chosen like
+ * home__kernels. Every backend gives the scalar reference's bytes exactly (integer arithmetic),
+ * which tests/test_stab.c checks on odd widths, unaligned pointers and clamped rows. */
+#ifndef HOME_STAB_KERNELS_H
+#define HOME_STAB_KERNELS_H
+#include <stddef.h>
+#include <stdint.h>
+
+/* Fixed point of warp coordinates: Q16 pixels; bilinear weights use the top 8 fraction bits. */
+#define HOME__WARP_FRAC_BITS 16
+
+/* One output row of a bilinear warp. Output pixel i samples the source at
+ * (x0 + i*dx, y0 + i*dy) (Q16 source pixels), clamped to [0, w-1] x [0, h-1] (edge replicate).
+ * Source pixel (x, y) is the byte src[y*stride + x*step]; output pixel i goes to dst[i*dst_step].
+ * Requires w, h >= 2 and every coordinate of the row within int32. With the fractions rounded to
+ * 1/256 (fx, fy in 0..256), the result is
+ * ((p00 (256-fx) + p01 fx) (256-fy) + (p10 (256-fx) + p11 fx) fy + 2^15) >> 16, and every
+ * implementation must give it bit for bit. */
+void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
+                      int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n);
+
+/* HOME_OK when im is a usable frame: known format, size within HOME's limits (even where
+ * chroma is subsampled), planes present, strides at least a row. */
+struct home_stab_image;
+int home__stab_check_image(const struct home_stab_image *im);
+
+/* A warp row kernel (home__warp_row_c's contract). */
+typedef void (*home__warp_row_fn)(const uint8_t *src, ptrdiff_t stride, int step, int w, int h,
+                                  int32_t x0, int32_t y0, int32_t dx, int32_t dy, uint8_t *dst,
+                                  int dst_step, int n);
+
+typedef struct home__stab_kernels {
+    const char *name;
+    home__warp_row_fn warp_row;
+} home__stab_kernels;
+
+/* 1 when every sample of the row lies inside [0, w-1) x [0, h-1) (no clamping needed). */
+int home__warp_row_inside(int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, int n);
+
+extern const home__stab_kernels home__stab_kernels_scalar;
+#if defined(__SSE2__)
+extern const home__stab_kernels home__stab_kernels_sse;
+#endif
+#if defined(__ARM_NEON) || defined(__ARM_NEON__)
+extern const home__stab_kernels home__stab_kernels_neon;
+#endif
+
+/* The table for a home_simd value (AVX2 contexts use SSE2: the gathers bound this kernel), or
+ * NULL when that backend is not compiled in. */
+const home__stab_kernels *home__stab_kernels_for(int simd);
+#endif
