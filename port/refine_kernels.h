@@ -38,6 +38,16 @@ typedef struct home__refine_kernels {
     void (*accumulate)(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
                        const int16_t *gys, const float *r, const float *w, int n,
                        const float *aff, float *acc);
+    /* Cauchy weights of the gain/bias fit, per lane (point i is lane i % 4): point i counts when
+     * i < n_valid, b[i] >= 0 and keep[i] >= 0; then with bi = b[i] (else bi = 0),
+     * q = (alpha bi + beta - t[i]) inv_c, w = 1 / (1 + q q) (else w = 0), wt[i] = w and
+     * part[k * 4 + lane] (zeroed first) sums w, w bi, w t, (w bi) bi, (w bi) t for k = 0..4.
+     * Returns how many points count. n is a multiple of 4. */
+    int (*cauchy_sums)(const float *b, const float *keep, const int16_t *t, int n, int n_valid,
+                       float alpha, float beta, float inv_c, float *wt, float *part);
+    /* res[i] = wt[i] > 0 ? alpha b[i] + beta - t[i] : 0. n is a multiple of 4. */
+    void (*residuals)(const float *b, const int16_t *t, const float *wt, int n, float alpha,
+                      float beta, float *res);
 } home__refine_kernels;
 
 extern const home__refine_kernels home__refine_kernels_scalar;

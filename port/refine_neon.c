@@ -158,8 +158,62 @@ static void accumulate_neon(const int16_t *xs, const int16_t *ys, const int16_t 
     for (k = 0; k < HOME__REFINE_ACC; k++) vst1q_f32(acc + k * HOME__REFINE_LANES, sum[k]);
 }
 
+static int cauchy_sums_neon(const float *b, const float *keep, const int16_t *t, int n,
+                            int n_valid, float alpha, float beta, float inv_c, float *wt,
+                            float *part)
+{
+    static const int32_t iota_v[4] = {0, 1, 2, 3};
+    const float32x4_t va = vdupq_n_f32(alpha), vbeta = vdupq_n_f32(beta), vc = vdupq_n_f32(inv_c);
+    const float32x4_t one = vdupq_n_f32(1.0f), zero = vdupq_n_f32(0.0f);
+    const int32x4_t limit = vdupq_n_s32(n_valid);
+    int32x4_t idx = vld1q_s32(iota_v);
+    uint32x4_t count = vdupq_n_u32(0);
+    float32x4_t p0 = zero, p1 = zero, p2 = zero, p3 = zero, p4 = zero;
+    uint32_t c[4];
+    int i;
+    for (i = 0; i < n; i += 4) {
+        float32x4_t vb = vld1q_f32(b + i), ti = load4_s16(t + i);
+        uint32x4_t ok = vandq_u32(vcltq_s32(idx, limit),
+                                  vandq_u32(vcgeq_f32(vb, zero), vcgeq_f32(vld1q_f32(keep + i), zero)));
+        float32x4_t bi = vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(vb), ok));
+        float32x4_t q = vmulq_f32(vsubq_f32(vaddq_f32(vmulq_f32(va, bi), vbeta), ti), vc);
+        float32x4_t w = divide(one, vaddq_f32(one, vmulq_f32(q, q)));
+        float32x4_t wb;
+        w = vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(w), ok));
+        wb = vmulq_f32(w, bi);
+        vst1q_f32(wt + i, w);
+        p0 = vaddq_f32(p0, w);
+        p1 = vaddq_f32(p1, wb);
+        p2 = vaddq_f32(p2, vmulq_f32(w, ti));
+        p3 = vaddq_f32(p3, vmulq_f32(wb, bi));
+        p4 = vaddq_f32(p4, vmulq_f32(wb, ti));
+        count = vsubq_u32(count, ok);
+        idx = vaddq_s32(idx, vdupq_n_s32(4));
+    }
+    vst1q_f32(part, p0);
+    vst1q_f32(part + 4, p1);
+    vst1q_f32(part + 8, p2);
+    vst1q_f32(part + 12, p3);
+    vst1q_f32(part + 16, p4);
+    vst1q_u32(c, count);
+    return (int)(c[0] + c[1] + c[2] + c[3]);
+}
+
+static void residuals_neon(const float *b, const int16_t *t, const float *wt, int n, float alpha,
+                           float beta, float *res)
+{
+    const float32x4_t va = vdupq_n_f32(alpha), vbeta = vdupq_n_f32(beta), zero = vdupq_n_f32(0.0f);
+    int i;
+    for (i = 0; i < n; i += 4) {
+        float32x4_t r = vsubq_f32(vaddq_f32(vmulq_f32(va, vld1q_f32(b + i)), vbeta), load4_s16(t + i));
+        uint32x4_t pos = vcgtq_f32(vld1q_f32(wt + i), zero);
+        vst1q_f32(res + i, vreinterpretq_f32_u32(vandq_u32(vreinterpretq_u32_f32(r), pos)));
+    }
+}
+
 const home__refine_kernels home__refine_kernels_neon = {
-    "neon", blur3_neon, downsample_neon, select_keys_neon, warp_neon, accumulate_neon};
+    "neon", blur3_neon, downsample_neon, select_keys_neon, warp_neon, accumulate_neon,
+    cauchy_sums_neon, residuals_neon};
 #else
 typedef int home__refine_neon_unused; /* ISO C forbids an empty translation unit */
 #endif

@@ -89,5 +89,37 @@ static void accumulate_scalar(const int16_t *xs, const int16_t *ys, const int16_
     }
 }
 
+static int cauchy_sums_scalar(const float *b, const float *keep, const int16_t *t, int n,
+                              int n_valid, float alpha, float beta, float inv_c, float *wt,
+                              float *part)
+{
+    int i, count = 0;
+    memset(part, 0, 5 * HOME__REFINE_LANES * sizeof *part);
+    for (i = 0; i < n; i++) {
+        const int lane = i & (HOME__REFINE_LANES - 1);
+        const int ok = i < n_valid && b[i] >= 0.0f && keep[i] >= 0.0f;
+        const float bi = ok ? b[i] : 0.0f, ti = (float)t[i];
+        const float q = (alpha * bi + beta - ti) * inv_c;
+        const float w = ok ? 1.0f / (1.0f + q * q) : 0.0f;
+        const float wb = w * bi;
+        wt[i] = w;
+        part[0 * HOME__REFINE_LANES + lane] += w;
+        part[1 * HOME__REFINE_LANES + lane] += wb;
+        part[2 * HOME__REFINE_LANES + lane] += w * ti;
+        part[3 * HOME__REFINE_LANES + lane] += wb * bi;
+        part[4 * HOME__REFINE_LANES + lane] += wb * ti;
+        count += ok;
+    }
+    return count;
+}
+
+static void residuals_scalar(const float *b, const int16_t *t, const float *wt, int n,
+                             float alpha, float beta, float *res)
+{
+    int i;
+    for (i = 0; i < n; i++) res[i] = wt[i] > 0.0f ? alpha * b[i] + beta - (float)t[i] : 0.0f;
+}
+
 const home__refine_kernels home__refine_kernels_scalar = {
-    "none", blur3_scalar, downsample_scalar, select_keys_scalar, warp_scalar, accumulate_scalar};
+    "none", blur3_scalar, downsample_scalar, select_keys_scalar, warp_scalar, accumulate_scalar,
+    cauchy_sums_scalar, residuals_scalar};

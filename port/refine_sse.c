@@ -164,8 +164,55 @@ static void accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *
     for (k = 0; k < HOME__REFINE_ACC; k++) _mm_storeu_ps(acc + k * HOME__REFINE_LANES, sum[k]);
 }
 
+static int cauchy_sums_sse(const float *b, const float *keep, const int16_t *t, int n, int n_valid,
+                           float alpha, float beta, float inv_c, float *wt, float *part)
+{
+    const __m128 va = _mm_set1_ps(alpha), vbeta = _mm_set1_ps(beta), vc = _mm_set1_ps(inv_c);
+    const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+    const __m128i limit = _mm_set1_epi32(n_valid), step = _mm_set1_epi32(4);
+    __m128i idx = _mm_setr_epi32(0, 1, 2, 3), count = _mm_setzero_si128();
+    __m128 p0 = zero, p1 = zero, p2 = zero, p3 = zero, p4 = zero;
+    int i, c[4];
+    for (i = 0; i < n; i += 4) {
+        __m128 vb = _mm_loadu_ps(b + i), ti = load4_s16(t + i);
+        __m128 ok = _mm_and_ps(_mm_castsi128_ps(_mm_cmplt_epi32(idx, limit)),
+                               _mm_and_ps(_mm_cmpge_ps(vb, zero), _mm_cmpge_ps(_mm_loadu_ps(keep + i), zero)));
+        __m128 bi = _mm_and_ps(vb, ok);
+        __m128 q = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(_mm_mul_ps(va, bi), vbeta), ti), vc);
+        __m128 w = _mm_and_ps(_mm_div_ps(one, _mm_add_ps(one, _mm_mul_ps(q, q))), ok);
+        __m128 wb = _mm_mul_ps(w, bi);
+        _mm_storeu_ps(wt + i, w);
+        p0 = _mm_add_ps(p0, w);
+        p1 = _mm_add_ps(p1, wb);
+        p2 = _mm_add_ps(p2, _mm_mul_ps(w, ti));
+        p3 = _mm_add_ps(p3, _mm_mul_ps(wb, bi));
+        p4 = _mm_add_ps(p4, _mm_mul_ps(wb, ti));
+        count = _mm_sub_epi32(count, _mm_castps_si128(ok));
+        idx = _mm_add_epi32(idx, step);
+    }
+    _mm_storeu_ps(part, p0);
+    _mm_storeu_ps(part + 4, p1);
+    _mm_storeu_ps(part + 8, p2);
+    _mm_storeu_ps(part + 12, p3);
+    _mm_storeu_ps(part + 16, p4);
+    _mm_storeu_si128((__m128i *)(void *)c, count);
+    return c[0] + c[1] + c[2] + c[3];
+}
+
+static void residuals_sse(const float *b, const int16_t *t, const float *wt, int n, float alpha,
+                          float beta, float *res)
+{
+    const __m128 va = _mm_set1_ps(alpha), vbeta = _mm_set1_ps(beta), zero = _mm_setzero_ps();
+    int i;
+    for (i = 0; i < n; i += 4) {
+        __m128 r = _mm_sub_ps(_mm_add_ps(_mm_mul_ps(va, _mm_loadu_ps(b + i)), vbeta), load4_s16(t + i));
+        _mm_storeu_ps(res + i, _mm_and_ps(r, _mm_cmpgt_ps(_mm_loadu_ps(wt + i), zero)));
+    }
+}
+
 const home__refine_kernels home__refine_kernels_sse = {
-    "sse", blur3_sse, downsample_sse, select_keys_sse, warp_sse, accumulate_sse};
+    "sse", blur3_sse, downsample_sse, select_keys_sse, warp_sse, accumulate_sse, cauchy_sums_sse,
+    residuals_sse};
 #else
 typedef int home__refine_sse_unused; /* ISO C forbids an empty translation unit */
 #endif

@@ -397,37 +397,27 @@ static double robust_cost(double r, double c)
 static int fit_photometric(solver *s, const home__refine_points *tp, const float *img_b,
                            const float *mask, double sigma, float *res, float *wt)
 {
-    const float inv_c = (float)(1.0 / (CAUCHY_K * sigma));
-    const float alpha = (float)s->alpha, beta = (float)s->beta;
-    double sw = 0, sb = 0, sa = 0, sbb = 0, sab = 0, den;
-    int i, n = 0;
-    /* branch-free: invalid points get weight 0 and add nothing */
-    for (i = 0; i < tp->n; i++) {
-        const int ok = img_b[i] >= 0.0f && (!mask || mask[i] >= 0.0f);
-        const float b = ok ? img_b[i] : 0.0f, a = (float)tp->t[i];
-        const float q = (alpha * b + beta - a) * inv_c;
-        const float w = ok ? 1.0f / (1.0f + q * q) : 0.0f;
-        const double wb = (double)w * b;
-        wt[i] = w;
-        sw += w; sb += wb; sa += (double)w * a; sbb += wb * b; sab += wb * a;
-        n += ok;
-    }
-    if (n && sw > 0) {
-        den = sw * sbb - sb * sb;
-        if (den > 1e-6 * sw * sw) {
-            s->alpha = (sw * sab - sb * sa) / den;
-            s->beta = (sa - s->alpha * sb) / sw;
+    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    float part[5 * LANES];
+    double sum[5], den;
+    int k, n;
+    n = s->st->rk->cauchy_sums(img_b, mask ? mask : img_b, tp->t, n4, tp->n, (float)s->alpha,
+                               (float)s->beta, (float)(1.0 / (CAUCHY_K * sigma)), wt, part);
+    for (k = 0; k < 5; k++)
+        sum[k] = ((double)part[k * LANES] + part[k * LANES + 1]) +
+                 ((double)part[k * LANES + 2] + part[k * LANES + 3]);
+    /* sum: w, w b, w a, w b b, w b a */
+    if (n && sum[0] > 0) {
+        den = sum[0] * sum[3] - sum[1] * sum[1];
+        if (den > 1e-6 * sum[0] * sum[0]) {
+            s->alpha = (sum[0] * sum[4] - sum[1] * sum[2]) / den;
+            s->beta = (sum[2] - s->alpha * sum[1]) / sum[0];
         } else {
             s->alpha = 1.0;
-            s->beta = (sa - sb) / sw;
+            s->beta = (sum[2] - sum[1]) / sum[0];
         }
     }
-    {
-        const float a2 = (float)s->alpha, b2 = (float)s->beta;
-        for (i = 0; i < tp->n; i++)
-            res[i] = wt[i] > 0.0f ? a2 * img_b[i] + b2 - (float)tp->t[i] : 0.0f;
-    }
-    for (; i < ((tp->n + LANES - 1) & ~(LANES - 1)); i++) res[i] = wt[i] = 0.0f;
+    s->st->rk->residuals(img_b, tp->t, wt, n4, (float)s->alpha, (float)s->beta, res);
     return n;
 }
 

@@ -394,6 +394,30 @@ void test_kernels_match_references(void)
         bad += fabs(s - ref[j]) > 1e-4 * (fabs(ref[j]) + 1.0);
     }
     CHECK_EQ_INT(bad, 0);
+    /* Cauchy fit sums: points past n_valid or with a negative sample or mask do not count */
+    {
+        static float wt[64], part[20];
+        double sums[5] = {0, 0, 0, 0, 0};
+        int count = 0, got;
+        for (i = 0; i < 64; i++) out[i] = i % 5 == 0 ? -1.0f : (float)(i * 3 % 200);
+        got = k->cauchy_sums(out, r, gx, 64, 60, 1.1f, -2.0f, 0.2f, wt, part);
+        for (i = 0, bad = 0; i < 64; i++) {
+            int ok = i < 60 && out[i] >= 0 && r[i] >= 0;
+            double q = (1.1 * out[i] - 2.0 - gx[i]) * 0.2, wi = ok ? 1.0 / (1.0 + q * q) : 0.0;
+            bad += fabs(wt[i] - wi) > 1e-6;
+            count += ok;
+            if (ok) {
+                sums[0] += wi; sums[1] += wi * out[i]; sums[2] += wi * gx[i];
+                sums[3] += wi * out[i] * out[i]; sums[4] += wi * out[i] * gx[i];
+            }
+        }
+        CHECK_EQ_INT(got, count);
+        for (j = 0; j < 5; j++) {
+            double s = (double)part[j * 4] + part[j * 4 + 1] + part[j * 4 + 2] + part[j * 4 + 3];
+            bad += fabs(s - sums[j]) > 1e-4 * (fabs(sums[j]) + 1.0);
+        }
+        CHECK_EQ_INT(bad, 0);
+    }
 }
 
 /* Every compiled-in backend reproduces the scalar kernels bit for bit: odd sizes, unaligned
@@ -406,6 +430,7 @@ void test_kernels_backends_identical(void)
     static int16_t t_ref[128], t_simd[128], k_ref[128], k_simd[128];
     static int16_t xs[260], ys[260], gx[260], gy[260];
     static float r[260], w[260], o_ref[260], o_simd[260], a_ref[44 * 4], a_simd[44 * 4];
+    static float w_ref[260], w_simd[260], r_simd[260];
     const float aff[3] = {0.0123f, -0.71f, -0.4f};
     float m[9];
     synth_rng rng;
@@ -448,6 +473,14 @@ void test_kernels_backends_identical(void)
             ref->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, a_ref);
             k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, a_simd);
             CHECK(memcmp(a_ref, a_simd, sizeof a_ref) == 0);
+            /* gain/bias fit: o_ref holds warped samples (some -1), r doubles as the keep mask */
+            CHECK_EQ_INT(ref->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_ref, a_ref),
+                         k->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_simd, a_simd));
+            CHECK(memcmp(w_ref, w_simd, 256 * sizeof *w_ref) == 0);
+            CHECK(memcmp(a_ref, a_simd, 20 * sizeof *a_ref) == 0);
+            ref->residuals(o_ref, gy + off, w_ref, 256, 0.93f, 2.25f, o_simd);
+            k->residuals(o_ref, gy + off, w_ref, 256, 0.93f, 2.25f, r_simd);
+            CHECK(memcmp(o_simd, r_simd, 256 * sizeof *r_simd) == 0);
         }
         printf("     %s: identical to scalar\n", k->name);
     }
