@@ -48,7 +48,7 @@ static void fixture(void)
     bad = cfg;
     ctx = ctx_other = NULL;
     needed = 0;
-    if (home_init(&ctx, &cfg, arena.bytes, sizeof arena.bytes, NULL) != HOME_OK) ctx = NULL;
+    if (home_init(&ctx, &cfg, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL) != HOME_OK) ctx = NULL;
     synth_render(SYNTH_STRUCTURED, 3, identity, 0.0, 1, img_a, W, H, W);
     memcpy(img_b, img_a, sizeof img_a);
     memset(&fa, 0, sizeof fa);
@@ -64,7 +64,7 @@ static void fixture(void)
     home_stab_default_config(&scfg, W, H);
     sbad = scfg;
     stab = NULL;
-    if (home_stab_init(&stab, &scfg, stab_arena.bytes, sizeof stab_arena.bytes, NULL) != HOME_OK) ctx = NULL;
+    if (home_stab_init(&stab, &scfg, ALIGNED_ARENA(stab_arena.bytes), ALIGNED_BYTES(stab_arena.bytes), NULL) != HOME_OK) ctx = NULL;
     memset(&sframe, 0, sizeof sframe);
     sframe.format = HOME_STAB_GREY;
     sframe.width = W;
@@ -93,7 +93,7 @@ static int match_foreign(int width, int height, int theta_bins)
     other.width = width;
     other.height = height;
     other.theta_bins = theta_bins;
-    if (home_init(&ctx_other, &other, arena_other.bytes, sizeof arena_other.bytes, NULL) != HOME_OK)
+    if (home_init(&ctx_other, &other, ALIGNED_ARENA(arena_other.bytes), ALIGNED_BYTES(arena_other.bytes), NULL) != HOME_OK)
         return 1;
     memset(img_other, 77, sizeof img_other);
     if (home_extract(ctx_other, img_other, width, &fb) != HOME_OK) return 1;
@@ -103,7 +103,7 @@ static int match_foreign(int width, int height, int theta_bins)
 /* home_init with a too-small arena must also report the exact size it needs */
 static int init_short(size_t bytes)
 {
-    int s = home_init(&ctx, &cfg, arena.bytes, bytes, &needed);
+    int s = home_init(&ctx, &cfg, ALIGNED_ARENA(arena.bytes), bytes, &needed);
     return (needed == home_arena_size(&cfg) && ctx == NULL) ? s : 1;
 }
 
@@ -187,14 +187,14 @@ static int y4m(const char *text, size_t size, int frames)
     X(arena_size_null, 0, (int)home_arena_size(NULL)) \
     X(arena_size_bad_config, 0, (bad.theta_bins = 0, (int)home_arena_size(&bad))) \
     /* context initialisation */ \
-    X(init_null_out, HOME_E_NULL, home_init(NULL, &cfg, arena.bytes, sizeof arena.bytes, NULL)) \
-    X(init_null_config, HOME_E_NULL, home_init(&ctx, NULL, arena.bytes, sizeof arena.bytes, NULL)) \
-    X(init_null_arena, HOME_E_NULL, home_init(&ctx, &cfg, NULL, sizeof arena.bytes, NULL)) \
-    X(init_bad_config, HOME_E_CONFIG, (bad.ratio = (float)NAN, home_init(&ctx, &bad, arena.bytes, sizeof arena.bytes, NULL))) \
+    X(init_null_out, HOME_E_NULL, home_init(NULL, &cfg, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL)) \
+    X(init_null_config, HOME_E_NULL, home_init(&ctx, NULL, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL)) \
+    X(init_null_arena, HOME_E_NULL, home_init(&ctx, &cfg, NULL, ALIGNED_BYTES(arena.bytes), NULL)) \
+    X(init_bad_config, HOME_E_CONFIG, (bad.ratio = (float)NAN, home_init(&ctx, &bad, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL))) \
     X(init_arena_empty, HOME_E_ARENA_SMALL, init_short(0)) \
     X(init_arena_one_byte_short, HOME_E_ARENA_SMALL, init_short(home_arena_size(&cfg) - 1)) \
-    X(init_arena_misaligned_1, HOME_E_ARENA_ALIGN, home_init(&ctx, &cfg, arena.bytes + 1, sizeof arena.bytes - 1, NULL)) \
-    X(init_arena_misaligned_8, HOME_E_ARENA_ALIGN, home_init(&ctx, &cfg, arena.bytes + 8, sizeof arena.bytes - 8, NULL)) \
+    X(init_arena_misaligned_1, HOME_E_ARENA_ALIGN, home_init(&ctx, &cfg, ALIGNED_ARENA(arena.bytes) + 1, ALIGNED_BYTES(arena.bytes) - 1, NULL)) \
+    X(init_arena_misaligned_8, HOME_E_ARENA_ALIGN, home_init(&ctx, &cfg, ALIGNED_ARENA(arena.bytes) + 8, ALIGNED_BYTES(arena.bytes) - 8, NULL)) \
     /* feature extraction */ \
     X(extract_null_context, HOME_E_NULL, home_extract(NULL, img_a, W, &fa)) \
     X(extract_null_image, HOME_E_NULL, home_extract(ctx, NULL, W, &fa)) \
@@ -204,7 +204,7 @@ static int y4m(const char *text, size_t size, int frames)
     X(extract_stride_negative, HOME_E_STRIDE, home_extract(ctx, img_a + (H - 1) * W, -W, &fa)) \
     X(extract_stride_overflows, HOME_E_STRIDE, home_extract(ctx, img_a, PTRDIFF_MAX / 2, &fa)) \
     X(extract_uninitialised_context, HOME_E_STATE, home_extract((home_context *)(void *)junk.bytes, img_a, W, &fa)) \
-    X(extract_context_overwritten, HOME_E_STATE, (memset(arena.bytes, 0, 64), home_extract(ctx, img_a, W, &fa))) \
+    X(extract_context_overwritten, HOME_E_STATE, (memset(ALIGNED_ARENA(arena.bytes), 0, 64), home_extract(ctx, img_a, W, &fa))) \
     /* matching: stages out of order, corrupted or foreign features */ \
     X(match_before_extract, HOME_E_STATE, (memset(&fb, 0, sizeof fb), home_match(ctx, &fa, &fb, &res))) \
     X(match_null_features, HOME_E_NULL, home_match(ctx, NULL, &fb, &res)) \
@@ -234,7 +234,7 @@ static int y4m(const char *text, size_t size, int frames)
     X(stab_odd_width, HOME_E_SIZE, (sbad.width = W + 1, home_stab_validate_config(&sbad))) \
     X(stab_margin_nan, HOME_E_CONFIG, (sbad.margin = (float)NAN, home_stab_validate_config(&sbad))) \
     X(stab_lookahead_above_max, HOME_E_CONFIG, (sbad.lookahead = HOME_STAB_MAX_LOOKAHEAD + 1, home_stab_validate_config(&sbad))) \
-    X(stab_arena_one_byte_short, HOME_E_ARENA_SMALL, home_stab_init(&stab, &scfg, stab_arena.bytes, home_stab_arena_size(&scfg) - 1, NULL)) \
+    X(stab_arena_one_byte_short, HOME_E_ARENA_SMALL, home_stab_init(&stab, &scfg, ALIGNED_ARENA(stab_arena.bytes), home_stab_arena_size(&scfg) - 1, NULL)) \
     X(stab_push_null_frame, HOME_E_NULL, home_stab_push(stab, NULL, &sout)) \
     X(stab_push_frame_of_other_size, HOME_E_MISMATCH, (sframe.height = H - 2, home_stab_push(stab, &sframe, &sout))) \
     X(stab_push_stride_below_width, HOME_E_STRIDE, (sframe.stride[0] = W - 1, home_stab_push(stab, &sframe, &sout))) \

@@ -3,6 +3,7 @@
  * the field failure this guards against. */
 #include "test.h"
 #include "home.h"
+#include "test_bad_input.h"
 #include "synth.h"
 #include <math.h>
 #include <string.h>
@@ -19,7 +20,7 @@ static home_context *pair_context(void)
     home_config cfg;
     home_context *ctx = NULL;
     home_default_config(&cfg, PW, PH);
-    if (home_init(&ctx, &cfg, pair_arena.bytes, sizeof pair_arena.bytes, NULL) != HOME_OK) return NULL;
+    if (home_init(&ctx, &cfg, ALIGNED_ARENA(pair_arena.bytes), ALIGNED_BYTES(pair_arena.bytes), NULL) != HOME_OK) return NULL;
     return ctx;
 }
 

@@ -66,7 +66,7 @@ static int register_layout(home_config *cfg, int fill, ptrdiff_t stride, size_t 
     for (y = 0; y < (int)sizeof padded; y++) padded[y] = (uint8_t)(synth_uniform(&rng) * 256);
     for (y = 0; y < DH; y++) memcpy(img + y * stride, da + y * DW, DW);
     memset(proof_arena.bytes, fill, sizeof proof_arena.bytes);
-    if (home_init(&ctx, cfg, proof_arena.bytes, sizeof proof_arena.bytes, NULL) != HOME_OK) return -1;
+    if (home_init(&ctx, cfg, ALIGNED_ARENA(proof_arena.bytes), ALIGNED_BYTES(proof_arena.bytes), NULL) != HOME_OK) return -1;
     if (home_register(ctx, img, stride, db, DW, res) != HOME_OK) return -1;
     memcpy(fa, home_last_features(ctx, 0), sizeof *fa);
     memcpy(fb, home_last_features(ctx, 1), sizeof *fb);
@@ -146,7 +146,7 @@ static void job_nothing(void) {}
 static void job_default_config(void) { home_default_config(&s_cfg, DW, DH); }
 static void job_validate_config(void) { home_validate_config(&s_cfg); }
 static void job_arena_size(void) { home_arena_size(&s_cfg); }
-static void job_init(void) { home_init(&s_ctx, &s_cfg, proof_arena.bytes, sizeof proof_arena.bytes, NULL); }
+static void job_init(void) { home_init(&s_ctx, &s_cfg, ALIGNED_ARENA(proof_arena.bytes), ALIGNED_BYTES(proof_arena.bytes), NULL); }
 static void job_extract(void) { home_extract(s_ctx, da, DW, &s_fa); }
 static void job_match(void) { home_match(s_ctx, &s_fa, &s_fb, &s_res); }
 static void job_register(void) { home_register(s_ctx, da, DW, db, DW, &s_res); }
@@ -179,7 +179,7 @@ static void job_stab_init(void)
     home_stab_config c;
     home_stab_default_config(&c, DW, DH);
     c.lookahead = 2;
-    if (home_stab_init(&s_stab, &c, stab_arena.bytes, sizeof stab_arena.bytes, NULL) != HOME_OK) s_stab = NULL;
+    if (home_stab_init(&s_stab, &c, ALIGNED_ARENA(stab_arena.bytes), ALIGNED_BYTES(stab_arena.bytes), NULL) != HOME_OK) s_stab = NULL;
 }
 static home_stab_image s_frame_a, s_frame_b; /* static: the job's own frame stays small */
 static void job_stab_push(void)

@@ -252,10 +252,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(need % HOME_ARENA_ALIGN == 0);
 
     off = (flags & FLAG_MISALIGN) ? (size_t)fz_range(r, 1, HOME_ARENA_ALIGN - 1) : 0;
-    have = FZ_ARENA_BYTES - HOME_ARENA_ALIGN;
+    have = FZ_ARENA_BYTES - 2 * HOME_ARENA_ALIGN;
     if (status == HOME_OK && need <= have)
         have = (flags & FLAG_ARENA_SHORT) ? need - 1 - (size_t)fz_range(r, 0, (int)(need - 1 < 65535 ? need - 1 : 65535)) : need;
-    base = arena.bytes + ((FZ_ARENA_BYTES - have - off) & ~(size_t)(HOME_ARENA_ALIGN - 1)) + off;
+    base = fz_align16(arena.bytes) + ((FZ_ARENA_BYTES - HOME_ARENA_ALIGN - have - off) & ~(size_t)(HOME_ARENA_ALIGN - 1)) + off;
     {
         int init = home_init(&ctx, &cfg, base, have, &needed);
         int want = status != HOME_OK ? status

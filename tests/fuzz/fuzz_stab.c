@@ -111,12 +111,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(is_status(s));
     need = home_stab_arena_size(&cfg);
     FZ_CHECK((s == HOME_OK) == (need > 0));
-    have = need && need <= FZ_ARENA_BYTES ? need : FZ_ARENA_BYTES;
+    have = need && need <= FZ_ARENA_BYTES - 2 * HOME_ARENA_ALIGN ? need : FZ_ARENA_BYTES - 2 * HOME_ARENA_ALIGN;
     if ((flags & 4) && need > 1) have = need - 1;
     {
         size_t needed = 0;
         int want = s != HOME_OK ? s : need > have ? HOME_E_ARENA_SMALL : HOME_OK;
-        s = home_stab_init(&stab, &cfg, arena.bytes + FZ_ARENA_BYTES - (have & ~(size_t)15) - (have & 15 ? 16 : 0),
+        s = home_stab_init(&stab, &cfg, fz_align16(arena.bytes) + FZ_ARENA_BYTES - HOME_ARENA_ALIGN - (have & ~(size_t)15) - (have & 15 ? 16 : 0),
                            have, &needed);
         FZ_CHECK(s == want);
         if (s == HOME_E_ARENA_SMALL) FZ_CHECK(needed == need);

@@ -53,6 +53,13 @@ static inline size_t fz_remaining(const fz_reader *r)
     return r->size - r->pos;
 }
 
+/* The first 16-byte aligned byte of a buffer (C99 statics are only as aligned as their widest
+ * member type: 8 bytes on 32-bit ARM); callers keep 16 bytes of slack. */
+static inline unsigned char *fz_align16(unsigned char *p)
+{
+    return p + (-(uintptr_t)p & 15u);
+}
+
 #define FZ_CHECK(cond) do { if (!(cond)) { \
     fprintf(stderr, "%s:%d: invariant failed: %s\n", __FILE__, __LINE__, #cond); abort(); } } while (0)
 #endif

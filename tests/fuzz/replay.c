@@ -5,6 +5,7 @@
  *   home-fuzz-replay TARGET FILE...   the given inputs (e.g. a crash file from `make fuzz`)
  * The corpus root can be moved with HOME_FUZZ_CORPUS. A failed invariant aborts (a crash). */
 #define _POSIX_C_SOURCE 200809L
+#define _FILE_OFFSET_BITS 64 /* 32-bit targets: readdir() of a filesystem with 64-bit inodes */
 #include <dirent.h>
 #include <stdint.h>
 #include <stdio.h>
