@@ -37,8 +37,8 @@ static void mul3(const double *a, const double *b, double *o)
 
 int main(int argc, char **argv)
 {
-    static const int simds[3] = {HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_NEON};
-    static const char *names[3] = {"none", "sse", "neon"};
+    static const int simds[4] = {HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
+    static const char *names[4] = {"none", "sse", "avx2", "neon"};
     int frames = 30, width = 640, height = 360, levels = -1, i, f, s, k;
     enum synth_kind kind = SYNTH_STRUCTURED;
     uint8_t *img[2];
@@ -71,7 +71,7 @@ int main(int argc, char **argv)
     }
     printf("frames %d, %dx%d %s scene, corner motion <= 4 px a frame, noise 2.5\n", frames, width,
            height, kind == SYNTH_STRUCTURED ? "structured" : "weak-texture");
-    for (s = 0; s < 3; s++) {
+    for (s = 0; s < 4; s++) {
         home_config probe;
         home_default_config(&probe, width, height);
         probe.simd = simds[s];
