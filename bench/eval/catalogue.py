@@ -1,8 +1,9 @@
 """Which photographs the evaluation uses, and why.
 
-Chosen by what they show (never by how HOME did on them): real photographs
-only (generated patterns such as opencv-doc's chessboard.png and cards.png are
-left out), from Debian's opencv-doc, python3-skimage and visp-images-data.
+Chosen by what they show (the baselines' keypoint counts on a few trial pairs
+were looked at while choosing, never HOME's results): real photographs only
+(generated patterns such as opencv-doc's chessboard.png and cards.png are left
+out), from Debian's opencv-doc, python3-skimage and visp-images-data.
 The first entries of each list (QUICK_*) form the CI subset; they span all
 three packages so CI exercises every fetch path.
 """
@@ -14,14 +15,16 @@ O, S, V = "opencv-doc", "skimage", "visp"
 LINEAR = [  # straight structures dominate; many have large flat regions
     Photo(O, "building.jpg", "hotel facade: window grid, flat wall panels (crop without trees)",
           crop=(150, 0, 712, 400)),
-    Photo(O, "ela_original.jpg", "notebook and elastic band: long straight edges, almost no texture"),
+    Photo(O, "ela_original.jpg",
+          "notebook and elastic band: long straight edges, almost no texture"),
     Photo(S, "brick.png", "brick wall: mortar lines, repetitive"),
     Photo(V, "mbt/cube/image0000.pgm", "white table, cylinder, cube: few edges on flat surfaces"),
     Photo(O, "sudoku.png", "printed sudoku grid photographed at an angle"),
     Photo(O, "left01.jpg", "calibration chessboard held in an office"),
     Photo(O, "right05.jpg", "calibration chessboard, another pose and camera"),
     Photo(O, "stuff.jpg", "pencil, lighter and caps on a plain table: few straight edges"),
-    Photo(O, "licenseplate_motion.jpg", "car rear with motion blur: horizontal structures, texture smeared"),
+    Photo(O, "licenseplate_motion.jpg",
+          "car rear with motion blur: horizontal structures, texture smeared"),
     Photo(O, "blox.jpg", "wooden blocks: straight edges, flat faces"),
     Photo(O, "pca_test1.jpg", "dark bars on a white board: straight edges only"),
     Photo(O, "basketball1.png", "office wall and door frame, two people: large flat areas"),
@@ -55,7 +58,8 @@ NORMAL = [  # texture-rich natural, painted and cluttered scenes
     Photo(S, "gravel.png", "gravel: stochastic texture"),
     Photo(S, "motorcycle_left.png", "motorcycle in a cluttered garage"),
     Photo(V, "Klimt/Klimt.jpeg", "painting (The Kiss): ornament texture"),
-    Photo(V, "Solvay/Solvay_conference_1927_Version2_1024x705.jpg", "group photograph: faces, suits"),
+    Photo(V, "Solvay/Solvay_conference_1927_Version2_1024x705.jpg",
+          "group photograph: faces, suits"),
 ]
 
 QUICK_IMAGES = 4
@@ -73,7 +77,8 @@ VIDEO = [
     Scene("no-structure/texture", Photo(O, "starry_night.jpg", "painting"), blur=True),
     # structure, no texture: low-texture photographs, or texture removed
     Scene("structure/no-texture", Photo(O, "ela_original.jpg", "notebook and elastic band")),
-    Scene("structure/no-texture", Photo(V, "mbt/cube/image0000.pgm", "white table, cylinder, cube")),
+    Scene("structure/no-texture", Photo(V, "mbt/cube/image0000.pgm",
+                                        "white table, cylinder, cube")),
     Scene("structure/no-texture", Photo(O, "building.jpg", "hotel facade"), flatten=True,
           decay=0.6, blur=True),
     # no structure, no texture: smooth shading only

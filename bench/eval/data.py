@@ -23,7 +23,8 @@ PACKAGES = {
     "visp": ("visp-images-data", "usr/share/visp-images-data/ViSP-images"),
 }
 LICENCES = {
-    "opencv-doc": "OpenCV sample data (Apache-2.0 / BSD-3-Clause, see the package's copyright file)",
+    "opencv-doc": "OpenCV sample data (Apache-2.0 / BSD-3-Clause, see the package's "
+                  "copyright file)",
     "skimage": "scikit-image sample data (BSD-3-Clause per Debian's copyright file; "
                "upstream lists each photograph as public domain or CC0/CC-BY)",
     "visp": "ViSP dataset reference images (GPL-2, Inria)",

@@ -152,7 +152,8 @@ def main():
     wall = time.perf_counter() - t_start
 
     meta = {
-        "quick": args.quick, "home": args.home, "commit": git_describe(Path(args.home).resolve().parent),
+        "quick": args.quick, "home": args.home,
+        "commit": git_describe(Path(args.home).resolve().parent),
         "opencv": cv2.__version__, "python": platform.python_version(),
         "machine": f"{platform.machine()}, {os.cpu_count()} cores", "jobs": args.jobs,
         "packages": lib.versions, "wall_s": wall, "timing_s": timing,
