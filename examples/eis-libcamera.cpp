@@ -37,7 +37,7 @@ struct Options {
     unsigned width = 640, height = 480;
     std::string format = "yu12";
     long frames = 0;
-    float margin = 0.10f, smoothing = 15.0f;
+    float margin = 0.10f, smoothing = 0.0f;   // 0: automatic (see home_stab_config)
     int lookahead = 0;
     bool quiet = false;
 };

@@ -83,7 +83,7 @@ static int parse(int argc, char **argv, options *o)
     o->width = 640; o->height = 480;
     o->fourcc = V4L2_PIX_FMT_YUYV;
     o->buffers = 4; o->timeout_ms = 2000; o->window = 1;
-    o->margin = 0.10f; o->smoothing = 15.0f;
+    o->margin = 0.10f; o->smoothing = 0.0f;   /* automatic */
     for (i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         char *end = NULL;

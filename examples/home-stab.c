@@ -24,7 +24,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: home-stab [options] IN.y4m OUT.y4m      (- for stdin / stdout)\n"
             "  --margin F        crop margin per side, fraction of the frame (default 0.10)\n"
-            "  --smoothing F     path smoothing time constant, frames (default 15)\n"
+            "  --smoothing F     path smoothing time constant, frames (default: lookahead / 2, at\n"
+            "                    least 3; 15 without lookahead)\n"
             "  --lookahead N     frames of latency for fixed-lag smoothing (default 0)\n"
             "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 480 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
@@ -117,7 +118,7 @@ int main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
     home_stab_config cfg;
-    double margin = 0.10, smoothing = 15, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0;
+    double margin = 0.10, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0;
     double t_start, ms_reg = 0, ms_warp = 0, last_report;
     app ap;
     home_stab *stab = NULL;

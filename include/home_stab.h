@@ -56,7 +56,8 @@ typedef struct home_stab_config {
     int width, height;        /* frame size (luma) */
     float margin;             /* crop margin on each side, fraction of the side; 0.10 */
     float smoothing;          /* path smoothing time constant in frames (Kalman bandwidth
-                                 1/smoothing per frame); larger = steadier, more crop used */
+                                 1/smoothing per frame); larger = steadier, more crop used;
+                                 0 = automatic: lookahead / 2 (at least 3), causal 15 */
     int lookahead;            /* frames of latency used for fixed-lag smoothing; 0 = causal */
     int downscale;            /* register on luma box-averaged by 1, 2 or 4 */
     int keypoints_per_sign;   /* HOME's budget per frame (see home_config) */
@@ -105,7 +106,7 @@ typedef struct home_stab_output {
 
 typedef struct home_stab home_stab;
 
-/* Defaults for a width x height stream: margin 0.10, smoothing 15, lookahead 0, downscale 2
+/* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, downscale 2
  * for frames wider than 480 px (else 1), 500 keypoints per sign, refinement on, Hough on the
  * half-size registration image from 320 px wide. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
