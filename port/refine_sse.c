@@ -114,8 +114,8 @@ static void warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n
                                           _mm_and_ps(_mm_cmplt_ps(px, xmax), _mm_cmplt_ps(py, ymax))));
         __m128i ix, iy;
         __m128 fx, fy, p00, p01, p10, p11, top, bot, val;
-        int32_t cx[4], cy[4];
-        float f00[4], f01[4], f10[4], f11[4];
+        int32_t cx[4], cy[4], up[4], down[4];
+        __m128i vu, vd;
         px = _mm_and_ps(px, ok);          /* invalid lanes sample (0, 0): in bounds, discarded */
         py = _mm_and_ps(py, ok);
         ix = _mm_cvttps_epi32(px);
@@ -124,11 +124,18 @@ static void warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n
         fy = _mm_sub_ps(py, _mm_cvtepi32_ps(iy));
         _mm_storeu_si128((__m128i *)(void *)cx, ix);
         _mm_storeu_si128((__m128i *)(void *)cy, iy);
+        /* gather each 2x2 support as two pixel pairs, convert all four corners at once */
         for (k = 0; k < 4; k++) {
             const uint8_t *p = img + (ptrdiff_t)cy[k] * stride + cx[k];
-            f00[k] = (float)p[0]; f01[k] = (float)p[1]; f10[k] = (float)p[stride]; f11[k] = (float)p[stride + 1];
+            up[k] = p[0] | p[1] << 8;
+            down[k] = p[stride] | p[stride + 1] << 8;
         }
-        p00 = _mm_loadu_ps(f00); p01 = _mm_loadu_ps(f01); p10 = _mm_loadu_ps(f10); p11 = _mm_loadu_ps(f11);
+        vu = _mm_loadu_si128((const __m128i *)(const void *)up);
+        vd = _mm_loadu_si128((const __m128i *)(const void *)down);
+        p00 = _mm_cvtepi32_ps(_mm_and_si128(vu, _mm_set1_epi32(0xff)));
+        p01 = _mm_cvtepi32_ps(_mm_srli_epi32(vu, 8));
+        p10 = _mm_cvtepi32_ps(_mm_and_si128(vd, _mm_set1_epi32(0xff)));
+        p11 = _mm_cvtepi32_ps(_mm_srli_epi32(vd, 8));
         top = _mm_add_ps(p00, _mm_mul_ps(fx, _mm_sub_ps(p01, p00)));
         bot = _mm_add_ps(p10, _mm_mul_ps(fx, _mm_sub_ps(p11, p10)));
         val = _mm_add_ps(top, _mm_mul_ps(fy, _mm_sub_ps(bot, top)));

@@ -37,7 +37,7 @@
 #define MIN_POINTS 64       /* fewer usable template points at a level: textureless, decline */
 #define FINEST_MIN_POINTS 512 /* the level the estimate ends at needs this many points, else the
                                  next coarser one is the finest (faint texture: less noise there) */
-#define STEP_EPS_PX 0.01    /* convergence: largest corner update, full-resolution px */
+#define STEP_EPS_PX 0.02    /* convergence: largest corner update, full-resolution px */
 #define MAX_CORNER_STD_PX 0.5 /* corner standard deviation (Fisher or split-half) above this:
                                  ill conditioned */
 
@@ -357,17 +357,14 @@ static void level_matrix(const solver *s, const double *hn, int level, float *m)
 /* Robust scale: 1.4826 * median |r| over the valid points, from a histogram. */
 static double robust_sigma(const float *img_b, const int16_t *t, int n, double alpha, double beta)
 {
+    const float a = (float)alpha, b = (float)beta;
     int hist[HIST_BINS + 1], i, count = 0, half, acc = 0;
     memset(hist, 0, sizeof hist);
     for (i = 0; i < n; i++) {
-        double r, a;
-        int bin;
-        if (img_b[i] < 0.0f) continue;
-        r = alpha * img_b[i] + beta - t[i];
-        a = fabs(r) * 8.0;
-        bin = a < HIST_BINS ? (int)a : HIST_BINS;
-        hist[bin]++;
-        count++;
+        const float r = fabsf(a * img_b[i] + b - (float)t[i]) * 8.0f;
+        const int valid = img_b[i] >= 0.0f;
+        hist[r < (float)HIST_BINS ? (int)r : HIST_BINS] += valid;
+        count += valid;
     }
     if (!count) return SIGMA_FLOOR;
     half = (count + 1) / 2;
