@@ -1,15 +1,16 @@
 /* Sub-pixel photometric refinement of HOME's homography (issue 8).
  *
  * Method: inverse-compositional Lucas-Kanade (Baker & Matthews) of the 8 homography parameters on
- * a 2x2-box pyramid, coarse to fine, started from HOME's estimate. The template is frame A: its
+ * a uint8 pyramid (3x3 binomial blur at full resolution, then 2x2 means), coarse to fine,
+ * started from HOME's estimate. The template is frame A: its
  * points and gradients are chosen once per frame when it is extracted, so in video a frame costs
  * one pyramid, one point selection and a few warps of the new frame. Photometric invariance: a
  * gain and bias (alpha * B + beta ~ A) re-fitted by weighted least squares every iteration.
  * Robustness: IRLS with Cauchy weights at 2.385 sigma, sigma = 1.4826 * median |residual|, so
  * occluders and moving objects lose their pull. Every level has a fixed iteration cap.
  *
- * Template points: per level, the pixel of largest |gx| + |gy| in each block (4x4 at full
- * resolution, 2x2, 1x1) whose score clears a camera-noise floor, strongest first up to
+ * Template points: per level, the pixel of largest |gx| + |gy| in each block (4x4, 2x2 at the
+ * third level) whose score clears a camera-noise floor, strongest first (evenly spread) up to
  * HOME_REFINE_MAX_POINTS >> level. Flat regions contribute nothing to LK but time.
  *
  * The estimate ends at full resolution, or at the finest level with at least 512 template
@@ -41,7 +42,8 @@
 #define MAX_CORNER_STD_PX 0.5 /* corner standard deviation (Fisher or split-half) above this:
                                  ill conditioned */
 
-/* Block side of the point selection per level: 4x4 at full resolution, 2x2, then 1x1. */
+/* Block side of the point selection per level: 4x4, and 2x2 at quarter resolution so that level
+ * still offers more candidates than its capacity. */
 static int block_side(int level) { return level == 2 ? 2 : 4; }
 
 /* Selection floor of the score |gx| + |gy| (2x central differences of the blurred level): above
