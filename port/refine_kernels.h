@@ -26,8 +26,9 @@ typedef struct home__refine_kernels {
      * to 0 when storing. b is 1, 2 or 4. */
     void (*select_keys)(const uint8_t *row, ptrdiff_t stride, int w, int b, int dy,
                         int16_t *keys, int accumulate);
-    /* Bilinear samples at m * (x, y, 1) after the perspective divide, -1 where the point maps
-     * behind the camera or its 2x2 support leaves the w x h image. n is a multiple of 4. */
+    /* Bilinear samples at m * (x, y, 1) after the perspective divide (one reciprocal 1 / d, then
+     * two products), -1 where the point maps behind the camera or its 2x2 support leaves the
+     * w x h image. n is a multiple of 4. */
     void (*warp)(const float *m, const int16_t *xs, const int16_t *ys, int n, const uint8_t *img,
                  ptrdiff_t stride, int w, int h, float *out);
     /* Weighted normal equations of one inverse-compositional step, per lane:

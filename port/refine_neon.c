@@ -102,8 +102,9 @@ static void warp_neon(const float *m, const int16_t *xs, const int16_t *ys, int 
     for (i = 0; i < n; i += 4) {
         float32x4_t x = load4_s16(xs + i), y = load4_s16(ys + i);
         float32x4_t d = vaddq_f32(vaddq_f32(vmulq_f32(mm[6], x), vmulq_f32(mm[7], y)), mm[8]);
-        float32x4_t px = divide(vaddq_f32(vaddq_f32(vmulq_f32(mm[0], x), vmulq_f32(mm[1], y)), mm[2]), d);
-        float32x4_t py = divide(vaddq_f32(vaddq_f32(vmulq_f32(mm[3], x), vmulq_f32(mm[4], y)), mm[5]), d);
+        float32x4_t inv = divide(vdupq_n_f32(1.0f), d);
+        float32x4_t px = vmulq_f32(vaddq_f32(vaddq_f32(vmulq_f32(mm[0], x), vmulq_f32(mm[1], y)), mm[2]), inv);
+        float32x4_t py = vmulq_f32(vaddq_f32(vaddq_f32(vmulq_f32(mm[3], x), vmulq_f32(mm[4], y)), mm[5]), inv);
         uint32x4_t ok = vandq_u32(vandq_u32(vcgtq_f32(d, zero), vcgeq_f32(px, zero)),
                                   vandq_u32(vcgeq_f32(py, zero),
                                             vandq_u32(vcltq_f32(px, xmax), vcltq_f32(py, ymax))));

@@ -49,9 +49,9 @@ static void warp_scalar(const float *m, const int16_t *xs, const int16_t *ys, in
     int i;
     for (i = 0; i < n; i++) {
         float x = (float)xs[i], y = (float)ys[i];
-        float d = m[6] * x + m[7] * y + m[8];
-        float px = (m[0] * x + m[1] * y + m[2]) / d;
-        float py = (m[3] * x + m[4] * y + m[5]) / d;
+        float d = m[6] * x + m[7] * y + m[8], inv = 1.0f / d;
+        float px = (m[0] * x + m[1] * y + m[2]) * inv;
+        float py = (m[3] * x + m[4] * y + m[5]) * inv;
         if (d > 0.0f && px >= 0.0f && py >= 0.0f && px < xmax && py < ymax) {
             int ix = (int)px, iy = (int)py;
             float fx = px - (float)ix, fy = py - (float)iy;

@@ -107,8 +107,9 @@ static void warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n
     for (i = 0; i < n; i += 4) {
         __m128 x = load4_s16(xs + i), y = load4_s16(ys + i);
         __m128 d = _mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[6], x), _mm_mul_ps(mm[7], y)), mm[8]);
-        __m128 px = _mm_div_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[0], x), _mm_mul_ps(mm[1], y)), mm[2]), d);
-        __m128 py = _mm_div_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[3], x), _mm_mul_ps(mm[4], y)), mm[5]), d);
+        __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), d);
+        __m128 px = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[0], x), _mm_mul_ps(mm[1], y)), mm[2]), inv);
+        __m128 py = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(mm[3], x), _mm_mul_ps(mm[4], y)), mm[5]), inv);
         __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpge_ps(px, zero)),
                                _mm_and_ps(_mm_cmpge_ps(py, zero),
                                           _mm_and_ps(_mm_cmplt_ps(px, xmax), _mm_cmplt_ps(py, ymax))));

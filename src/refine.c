@@ -550,7 +550,7 @@ static double photometric_error(solver *s, const float *img_b, const float *othe
     int i, it, n = 0;
     s->alpha = 1.0;
     s->beta = 0.0;
-    for (it = 0; it < 3; it++) fit_photometric(s, tp, img_b, other_b, sigma, s->res, s->wt);
+    for (it = 0; it < 2; it++) fit_photometric(s, tp, img_b, other_b, sigma, s->res, s->wt);
     for (i = 0; i < tp->n; i++) {
         double w = s->wt[i], a = tp->t[i], b = img_b[i];
         if (img_b[i] < 0.0f || other_b[i] < 0.0f) continue;
