@@ -26,10 +26,14 @@ Metrics, all on luma, computed the same way for every method from its output fra
              output path's per-frame translation and rotation, the smaller of the two
   crop       mean scale of M_t (1 = the full frame is shown); valid = mean share of output
              pixels inside the input (below 1: borders)
+  follow     px RMS between the low-frequency output path and the intended camera path (the
+             clip without jitter) at the output's zoom: the wanted motion that was dropped or
+             distorted. ITF rewards dropping it (a frozen picture scores best), so read the two
+             together
   fps        frames / wall time of the whole process (both passes for vidstab), and frames per
              CPU second (user + system time of the process and all its threads: steadier on a
              shared machine, and fair to multi-threaded filters)
-Usage: python3 bench/stab/compare.py [--quick] [--build build] [--frames N] [--out DIR]
+Usage: python3 bench/stab/compare.py [--quick | --smoke] [--build build] [--frames N] [--out DIR]
 """
 import argparse
 import glob
@@ -94,11 +98,13 @@ def read_y4m_luma(path):
     return frames
 
 
-def read_truth(path):
+def read_truth(path, intended=False):
+    """The true camera per frame (reference -> frame t), or the intended one (no jitter)."""
     rows = np.loadtxt(path, delimiter=",", skiprows=1)
+    c = 7 if intended else 1
     g = np.zeros((len(rows), 3, 3))
-    g[:, 0, :] = rows[:, 1:4]
-    g[:, 1, :] = rows[:, 4:7]
+    g[:, 0, :] = rows[:, c:c + 3]
+    g[:, 1, :] = rows[:, c + 3:c + 6]
     g[:, 2, 2] = 1
     return g
 
@@ -203,7 +209,7 @@ def components(g):
     return np.stack([tx, ty, rot * HALF_DIAG], 1)
 
 
-def jitter(path, sigma=4.0, trim=6):
+def lowpass(path, sigma=4.0):
     n = len(path)
     k = np.arange(-int(3 * sigma), int(3 * sigma) + 1)
     wts = np.exp(-0.5 * (k / sigma) ** 2)
@@ -211,8 +217,23 @@ def jitter(path, sigma=4.0, trim=6):
     for t in range(n):
         idx = np.clip(t + k, 0, n - 1)
         smooth[t] = (wts[:, None] * path[idx]).sum(0) / wts.sum()
-    hf = (path - smooth)[trim:n - trim]
+    return smooth
+
+
+def jitter(path, sigma=4.0, trim=6):
+    n = len(path)
+    hf = (path - lowpass(path, sigma))[trim:n - trim]
     return float(np.sqrt(np.mean(hf ** 2)))
+
+
+def follow(path, intended, scale, trim=6):
+    """RMS px between the output's low-frequency path and the intended camera seen at the
+    output's zoom (offset removed): how much of the wanted motion was kept, or added."""
+    want = intended.copy()
+    want[:, :2] /= scale
+    d = (lowpass(path) - want)[trim:len(path) - trim]
+    d -= d.mean(0)
+    return float(np.sqrt(np.mean(d ** 2)))
 
 
 def stability(path):
@@ -243,13 +264,14 @@ def itf(outs, maps):
     return float(np.mean(vals)), float(np.mean([m.mean() for m in masks]))
 
 
-def measure(outs, ins, truth):
+def measure(outs, ins, truth, intended):
     maps = output_maps(outs, ins)
     o = np.array([np.linalg.inv(m) @ g for m, g in zip(maps, truth)])
     path = components(o)
     it, valid = itf(outs, maps)
     crop = float(np.mean(np.sqrt(np.abs(np.linalg.det(maps[:, :2, :2])))))
-    return {"jitter": jitter(path), "itf": it, "stability": stability(path), "crop": min(crop, 1.0), "valid": valid}
+    return {"jitter": jitter(path), "itf": it, "stability": stability(path), "crop": min(crop, 1.0), "valid": valid,
+            "follow": follow(path, components(intended), crop)}
 
 
 # ---- the run ---------------------------------------------------------------------------------
@@ -259,13 +281,14 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--frames", type=int, default=120)
     ap.add_argument("--quick", action="store_true", help="one photograph per category, 60 frames")
+    ap.add_argument("--smoke", action="store_true", help="CI: one structured clip of 40 frames")
     ap.add_argument("--out", default=None, help="work directory (default BUILD/bench-stab)")
     ap.add_argument("--cache", default=os.environ.get("HOME_EVAL_CACHE", str(REPO / "build/eval-cache")))
     args = ap.parse_args()
     build = REPO / args.build
     work = Path(args.out) if args.out else build / "bench-stab"
     work.mkdir(parents=True, exist_ok=True)
-    frames = 60 if args.quick else args.frames
+    frames = 40 if args.smoke else 60 if args.quick else args.frames
     photos = photo_dir(Path(args.cache))
     stab, clip = build / "bin/home-stab", build / "bin/home-stab-clip"
     for tool in (stab, clip):
@@ -285,7 +308,9 @@ def main():
     results = {}   # (category, method) -> list of metric dicts
     input_jitter = {}
     for cat, items in PHOTOS.items():
-        for k, (name, decay) in enumerate(items[:1] if args.quick else items):
+        if args.smoke and cat != "structured":
+            continue
+        for k, (name, decay) in enumerate(items[:1] if args.quick or args.smoke else items):
             stem = "%s_%s" % (cat, Path(name).stem)
             pgm = work / ("%s.pgm" % Path(name).stem)
             if not pgm.exists():
@@ -297,6 +322,7 @@ def main():
                  "--decay", str(decay), "--noise", "2", "--seed", str(11 + k), str(c), str(truth_csv)])
             ins = read_y4m_luma(c)
             truth = read_truth(truth_csv)
+            intended = read_truth(truth_csv, intended=True)
             input_jitter.setdefault(cat, []).append(jitter(components(truth)))
             for mname, cmds in methods.items():
                 o = work / ("%s_%s.y4m" % (stem, mname.replace(" ", "_")))
@@ -305,22 +331,23 @@ def main():
                 outs = read_y4m_luma(o)
                 if len(outs) != len(ins):
                     sys.exit("%s wrote %d frames of %d" % (mname, len(outs), len(ins)))
-                m = measure(outs, ins, truth)
+                m = measure(outs, ins, truth, intended)
                 m["fps"] = len(ins) / wall
                 m["cpu_fps"] = len(ins) / cpu
                 results.setdefault((cat, mname), []).append(m)
-                print("%-12s %-22s %-15s jitter %6.3f px  ITF %6.2f dB  stability %.3f  crop %.3f  valid %.3f  %6.1f fps (%.1f per CPU s)" %
+                print("%-12s %-22s %-15s jitter %6.3f px  ITF %6.2f dB  stability %.3f  crop %.3f  valid %.3f  follow %5.2f px  %6.1f fps (%.1f per CPU s)" %
                       (cat, Path(name).stem + (" a=%.1f" % decay if decay else ""), mname, m["jitter"], m["itf"],
-                       m["stability"], m["crop"], m["valid"], m["fps"], m["cpu_fps"]), flush=True)
+                       m["stability"], m["crop"], m["valid"], m["follow"], m["fps"], m["cpu_fps"]), flush=True)
 
     print("\n%d frames of %dx%d per clip; input jitter (px RMS):" % (frames, W, H),
           ", ".join("%s %.2f" % (c, np.mean(v)) for c, v in input_jitter.items()))
-    print("\n| category | method | jitter px | ITF dB | stability | crop | valid | fps (wall) | frames per CPU s |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("\n| category | method | jitter px | ITF dB | stability | crop | valid | follow px | fps (wall) | frames per CPU s |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for (cat, mname), ms in results.items():
         avg = {k: np.mean([m[k] for m in ms]) for k in ms[0]}
-        print("| %s | %s | %.3f | %.2f | %.3f | %.3f | %.3f | %.1f | %.1f |" %
-              (cat, mname, avg["jitter"], avg["itf"], avg["stability"], avg["crop"], avg["valid"], avg["fps"], avg["cpu_fps"]))
+        print("| %s | %s | %.3f | %.2f | %.3f | %.3f | %.3f | %.2f | %.1f | %.1f |" %
+              (cat, mname, avg["jitter"], avg["itf"], avg["stability"], avg["crop"], avg["valid"], avg["follow"], avg["fps"],
+               avg["cpu_fps"]))
 
 
 if __name__ == "__main__":
