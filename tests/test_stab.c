@@ -202,6 +202,42 @@ static void test_hold_on_failure(void)
     CHECK_LT(max_step, 0.1 * CW);
 }
 
+/* A frame from a camera 60 px away (a glitch, or a cut and back) is not followed: the motion to
+ * it and back is refused as implausible or failed, so the path holds and the output stays. */
+static void test_implausible_jump_held(void)
+{
+    static uint8_t jumped[CW * CH * 3 / 2];
+    home_stab *st = make_stab(0, 1);
+    home_stab_output o;
+    home_stab_image im;
+    double g[9], max_step = 0, prev_x = 0, prev_y = 0;
+    int t, refused = 0, inside = 1;
+    CHECK(st != NULL);
+    if (!st) return;
+    render_clip();
+    memcpy(g, clip_g[20], sizeof g);
+    g[2] += 60.0;
+    synth_render(SYNTH_STRUCTURED, 1, g, 1.0, 99, jumped, CW, CH, CW);
+    memset(jumped + CW * CH, 128, CW * CH / 2);
+    for (t = 0; t < 40; t++) {
+        grey_image(t == 20 ? jumped : clip[t], &im);
+        CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_OK);
+        if (t == 20 || t == 21)
+            refused += o.newest_status == HOME_STAB_MOTION_IMPLAUSIBLE || o.newest_status == HOME_STAB_MOTION_FAILED;
+        inside &= corners_inside(o.warp);
+        if (t > 0 && t != 20 && t != 21) {
+            double step = hypot(o.warp[2] - prev_x, o.warp[5] - prev_y);
+            if (step > max_step) max_step = step;
+        }
+        prev_x = o.warp[2];
+        prev_y = o.warp[5];
+    }
+    printf("    jump refused on %d of 2 frames, largest warp change elsewhere %.2f px\n", refused, max_step);
+    CHECK_EQ_INT(refused, 2);
+    CHECK(inside);
+    CHECK_LT(max_step, 0.1 * CW);
+}
+
 static void test_deterministic(void)
 {
     static run_result a, b;
@@ -427,7 +463,7 @@ static void test_api_contract(void)
 #define STAB_TESTS(X) \
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
     X(warp_formats_agree) X(warp_backends_identical) X(jitter_reduced_causal) X(lookahead_latency_and_gain) \
-    X(downscaled_registration) X(hold_on_failure) X(deterministic)
+    X(downscaled_registration) X(hold_on_failure) X(implausible_jump_held) X(deterministic)
 #define ENTRY(name) {#name, test_##name},
 static const struct { const char *name; void (*fn)(void); } tests[] = {STAB_TESTS(ENTRY)};
 
