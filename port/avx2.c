@@ -1,6 +1,8 @@
 /* AVX2 Radon kernel (x86-64 CPUs that report AVX2; compiled with -mavx2). The other kernels
  * of this table are the SSE2 ones: only the Hough accumulation gained from wider vectors. */
 #include "kernels.h"
+#include "refine_kernels.h"
+#include "stab_kernels.h"
 #if defined(HOME__HAVE_AVX2) && defined(__AVX2__)
 #include <immintrin.h>
 
@@ -41,7 +43,8 @@ static void radon_blocks_avx2(const uint8_t *base, ptrdiff_t stride, const int16
 }
 
 const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
-                                          home__smooth_row_sse, home__smooth_cols_sse};
+                                          home__smooth_row_sse, home__smooth_cols_sse,
+    &home__refine_kernels_sse, &home__stab_kernels_sse};
 #else
 typedef int home__avx2_unavailable; /* ISO C forbids an empty translation unit */
 #endif

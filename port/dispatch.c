@@ -1,6 +1,8 @@
 /* The one dispatch point: maps a home_simd request to a kernel table. Compiled with baseline
  * flags; the tables live in per-ISA files. No state: each context stores its own table. */
 #include "kernels.h"
+#include "refine_kernels.h"
+#include "stab_kernels.h"
 #include "home.h"
 
 const home__kernels *home__kernels_for(int simd)
@@ -37,4 +39,17 @@ const home__kernels *home__kernels_for(int simd)
 #endif
     default: return NULL;
     }
+}
+
+/* The refinement's and the stabiliser's tables follow the same choice. */
+const home__refine_kernels *home__refine_kernels_for(int simd)
+{
+    const home__kernels *k = home__kernels_for(simd);
+    return k ? k->refine : NULL;
+}
+
+const home__stab_kernels *home__stab_kernels_for(int simd)
+{
+    const home__kernels *k = home__kernels_for(simd);
+    return k ? k->stab : NULL;
 }

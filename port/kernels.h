@@ -13,6 +13,9 @@
 /* Rows summed in 16-bit lanes before widening: 128 * 255 = 32640 fits int16. */
 #define HOME__RADON_ROWS_16BIT 128
 
+struct home__refine_kernels; /* port/refine_kernels.h */
+struct home__stab_kernels;   /* port/stab_kernels.h */
+
 typedef struct home__kernels {
     const char *name;
     /* Shear-and-add line sums for n_blocks blocks of HOME__RADON_BLOCK intercepts:
@@ -34,6 +37,9 @@ typedef struct home__kernels {
     /* out[i] = sum_k taps[k] * rows[k][i] (k = 0 .. 2 radius, in this order), i in [0, n). */
     void (*smooth_cols)(const float *const *rows, float *out, int n, const float *taps,
                         int radius);
+    /* the photometric refinement's and the stabiliser's kernels of the same backend */
+    const struct home__refine_kernels *refine;
+    const struct home__stab_kernels *stab;
 } home__kernels;
 
 extern const home__kernels home__kernels_scalar;
@@ -57,7 +63,7 @@ extern const home__kernels home__kernels_avx2;
 extern const home__kernels home__kernels_neon;
 #endif
 
-/* The table for a home_simd value (HOME_SIMD_AUTO picks the best compiled in), or NULL when
- * that backend is not compiled into this build. */
+/* The one dispatch point. The table for a home_simd value (HOME_SIMD_AUTO picks the best
+ * compiled in), or NULL when that backend is not compiled into this build. */
 const home__kernels *home__kernels_for(int simd);
 #endif

@@ -1,5 +1,7 @@
 /* NEON kernels (aarch64, and armv7 built with -mfpu=neon). */
 #include "kernels.h"
+#include "refine_kernels.h"
+#include "stab_kernels.h"
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #include <arm_neon.h>
 
@@ -82,7 +84,8 @@ static void smooth_cols_neon(const float *const *rows, float *out, int n, const 
 }
 
 const home__kernels home__kernels_neon = {"neon", radon_blocks_neon, nearest2_l1_neon,
-                                          smooth_row_neon, smooth_cols_neon};
+                                          smooth_row_neon, smooth_cols_neon,
+    &home__refine_kernels_neon, &home__stab_kernels_neon};
 #else
 typedef int home__neon_unavailable; /* ISO C forbids an empty translation unit */
 #endif

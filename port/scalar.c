@@ -1,5 +1,7 @@
 /* Scalar reference kernels: the definition every SIMD backend must reproduce bit for bit. */
 #include "kernels.h"
+#include "refine_kernels.h"
+#include "stab_kernels.h"
 #include <string.h>
 
 static void radon_blocks_scalar(const uint8_t *base, ptrdiff_t stride, const int16_t *shift,
@@ -53,4 +55,5 @@ static void smooth_cols_scalar(const float *const *rows, float *out, int n, cons
 }
 
 const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
-                                            smooth_row_scalar, smooth_cols_scalar};
+                                            smooth_row_scalar, smooth_cols_scalar,
+    &home__refine_kernels_scalar, &home__stab_kernels_scalar};

@@ -1,5 +1,7 @@
 /* SSE2 kernels (x86-64 baseline). */
 #include "kernels.h"
+#include "refine_kernels.h"
+#include "stab_kernels.h"
 #if defined(__SSE2__)
 #include <emmintrin.h>
 
@@ -83,7 +85,8 @@ void home__smooth_cols_sse(const float *const *rows, float *out, int n, const fl
 }
 
 const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, home__nearest2_l1_sse,
-                                         home__smooth_row_sse, home__smooth_cols_sse};
+                                         home__smooth_row_sse, home__smooth_cols_sse,
+    &home__refine_kernels_sse, &home__stab_kernels_sse};
 #else
 typedef int home__sse_unavailable; /* ISO C forbids an empty translation unit */
 #endif
