@@ -149,7 +149,8 @@ void test_bad_inputs(void)
     home_config cfg, bad;
     home_context *ctx;
     home_result res;
-    static union { unsigned char b[1 << 16]; double d; } small;
+    static union { unsigned char b[(1 << 16) + 16]; double d; } small_storage;
+    unsigned char *small = (unsigned char *)(((uintptr_t)small_storage.b + 15) & ~(uintptr_t)15);
     size_t need = 0;
     CHECK_EQ_INT(home_default_config(NULL, IMG_W, IMG_H), HOME_E_NULL);
     CHECK_EQ_INT(home_default_config(&cfg, 0, IMG_H), HOME_E_SIZE);
@@ -165,9 +166,9 @@ void test_bad_inputs(void)
     bad = cfg; bad.r_bins = 101; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.threshold_start = 0.5f; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
     CHECK_EQ_INT(home_arena_size(&bad), 0);
-    CHECK_EQ_INT(home_init(NULL, &cfg, small.b, sizeof small.b, NULL), HOME_E_NULL);
+    CHECK_EQ_INT(home_init(NULL, &cfg, small, (size_t)1 << 16, NULL), HOME_E_NULL);
     CHECK_EQ_INT(home_init(&ctx, &cfg, NULL, 1 << 30, NULL), HOME_E_NULL);
-    CHECK_EQ_INT(home_init(&ctx, &cfg, small.b, sizeof small.b, &need), HOME_E_ARENA_SMALL);
+    CHECK_EQ_INT(home_init(&ctx, &cfg, small, (size_t)1 << 16, &need), HOME_E_ARENA_SMALL);
     CHECK_EQ_INT(need, home_arena_size(&cfg));
     CHECK(ctx == NULL);
     CHECK(strlen(home_strerror(HOME_E_ARENA_SMALL)) > 10);

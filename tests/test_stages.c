@@ -29,26 +29,27 @@ void test_config_defaults(void)
 void test_arena_layout(void)
 {
     home_config cfg;
-    static union { unsigned char b[4u << 20]; double d; } mem;
+    static union { unsigned char b[(4u << 20) + 64]; double d; } storage;
+    unsigned char *mem = (unsigned char *)(((uintptr_t)storage.b + 63) & ~(uintptr_t)63);
     home_context *ctx;
     size_t need, got = 0;
     home_default_config(&cfg, 640, 360);
     need = home_arena_size(&cfg);
     CHECK(need > 0);
     CHECK(need <= (size_t)2 << 20);                          /* <= 2 MiB at 640x360 */
-    CHECK_EQ_INT(home_init(&ctx, &cfg, mem.b, need - 1, &got), HOME_E_ARENA_SMALL);
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem, need - 1, &got), HOME_E_ARENA_SMALL);
     CHECK_EQ_INT(got, need);
-    CHECK_EQ_INT(home_init(&ctx, &cfg, mem.b + 1, need, NULL), HOME_E_ARENA_ALIGN);
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem + 1, need, NULL), HOME_E_ARENA_ALIGN);
     /* the context stays inside exactly `need` bytes: a canary right after it survives use */
-    mem.b[need] = 0xA5;
-    CHECK_EQ_INT(home_init(&ctx, &cfg, mem.b, need, NULL), HOME_OK);
+    mem[need] = 0xA5;
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem, need, NULL), HOME_OK);
     {
         static uint8_t a[640 * 360];
         home_result res;
         synth_render(SYNTH_STRUCTURED, 3, (const double[9]){1, 0, 0, 0, 1, 0, 0, 0, 1}, 2.5, 9, a, 640, 360, 640);
         CHECK_EQ_INT(home_register(ctx, a, 640, a, 640, &res), HOME_OK);
     }
-    CHECK_EQ_INT(mem.b[need], 0xA5);
+    CHECK_EQ_INT(mem[need], 0xA5);
 }
 
 void test_heap_keeps_top_k(void)
