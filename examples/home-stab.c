@@ -27,7 +27,7 @@ static void usage(FILE *f)
             "  --smoothing F     path smoothing time constant, frames (default: lookahead / 2, at\n"
             "                    least 3; 15 without lookahead)\n"
             "  --lookahead N     frames of latency for fixed-lag smoothing (default 0)\n"
-            "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 480 px)\n"
+            "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 960 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"

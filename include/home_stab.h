@@ -107,7 +107,7 @@ typedef struct home_stab_output {
 typedef struct home_stab home_stab;
 
 /* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, downscale 2
- * for frames wider than 480 px (else 1), 500 keypoints per sign, refinement on, Hough on the
+ * for frames wider than 960 px (else 1), 500 keypoints per sign, refinement on, Hough on the
  * half-size registration image from 320 px wide. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 

@@ -58,7 +58,9 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
     cfg->margin = 0.10f;
     cfg->smoothing = 0.0f;   /* automatic: see home_stab_config */
     cfg->lookahead = 0;
-    cfg->downscale = width > 480 ? 2 : 1;
+    /* registration at full size up to 960 px wide: on the bench's textureless clips, half size
+     * (640x360 -> 320x180) left 4x the jitter (0.280 vs 0.070 px) for 1.5x the speed */
+    cfg->downscale = width > 960 ? 2 : 1;
     cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 500 ? HOME_MAX_KEYPOINTS_PER_SIGN : 500;
     cfg->min_inliers = 20;
     cfg->refine = 1;
