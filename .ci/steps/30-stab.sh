@@ -11,7 +11,9 @@ SUDO=""
 $SUDO apt-get install -y -qq --no-install-recommends g++ pkg-config libsdl2-dev libcamera-dev ffmpeg \
   linux-libc-dev > /dev/null
 
-BUILD=build-ci-stab
+# `make test` built everything before SDL2 and libcamera were here: rebuild only what they change
+BUILD=${STAB_CI_BUILD:-build}
+rm -f "$BUILD/obj/examples/eis-v4l2.o" "$BUILD/bin/eis-v4l2" "$BUILD/bin/eis-libcamera"
 make -j2 BUILD=$BUILD all
 for bin in eis-v4l2 eis-libcamera home-stab home-stab-clip; do
   [ -x "$BUILD/bin/$bin" ] || { echo "30-stab: $bin was not built"; exit 1; }
@@ -25,11 +27,14 @@ trap 'rm -rf "$tmp"' EXIT
 ok() { passed=$((passed + 1)); echo "ok   $1"; echo "$1" >> "$tmp/passed"; }
 fail() { failed=$((failed + 1)); echo "FAIL $1${2:+: $2}"; }
 RUNNER=""
-"$BUILD/bin/home-stab-tests" | tee "$tmp/unit.out"
+"$BUILD/bin/home-stab-tests" | tee "$tmp/unit.out" || true
 line=$(tail -n 1 "$tmp/unit.out")
 [[ $line =~ ^([0-9]+)\ passed,\ 0\ failed$ ]] && ok home-stab-tests || fail home-stab-tests "$line"
+# the checks run commands that are meant to fail (as under tests/run.sh, which has no set -e)
+set +eu
 # shellcheck source=/dev/null
 . tests/checks/stab.sh
+set -eu
 # with the dependencies installed, none of the optional checks may have been skipped
 for name in stab_y4m_matches_ffmpeg stab_v4l2_injected_faults stab_v4l2_disconnect_clean_exit stab_libcamera_no_camera; do
   grep -qx "$name" "$tmp/passed" || fail "$name" "did not run"
