@@ -154,7 +154,8 @@ enum home_failure {
     HOME_FAIL_NONE = 0,
     HOME_FAIL_FEW_MATCHES,    /* too few matches to estimate a homography */
     HOME_FAIL_FEW_INLIERS,    /* fewer than min_inliers at the final threshold */
-    HOME_FAIL_DEGENERATE      /* det(H / H22) <= 0, or the estimate is numerically unusable */
+    HOME_FAIL_DEGENERATE      /* det(H / H22) <= 0, an image corner mapped behind the camera
+                                 (w <= 0), or a numerically unusable estimate */
 };
 
 /* What the photometric refinement did (result.refine_status). */
@@ -176,7 +177,8 @@ enum home_refine_status {
 typedef struct home_result {
     int ok;                   /* 1: H is trustworthy by the failure rule */
     int failure;              /* enum home_failure */
-    double H[9];              /* A -> B, row-major, H[8] = 1 (identity when not ok) */
+    double H[9];              /* A -> B, row-major, H[8] = 1; when not ok, the rejected
+                                 estimate (identity if there was none) */
     int keypoints_a, keypoints_b, matches, inliers;
     int refined;              /* 1: H is HOME's estimate refined photometrically */
     int refine_status;        /* enum home_refine_status */

@@ -153,6 +153,18 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
         if (!isfinite(h[k])) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
     for (k = 0; k < 9; k++) result->H[k] = h[k];
     if (!(det3(h) > 0.0)) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
+    {
+        /* plausibility: every image corner must stay in front (w > 0); a homography that folds
+         * part of the frame through infinity is never a real camera motion between frames */
+        const double xs[2] = {0.0, cfg->width - 1.0}, ys[2] = {0.0, cfg->height - 1.0};
+        int cx_i, cy_i;
+        for (cx_i = 0; cx_i < 2; cx_i++)
+            for (cy_i = 0; cy_i < 2; cy_i++)
+                if (!(h[6] * xs[cx_i] + h[7] * ys[cy_i] + h[8] > 0.0)) {
+                    result->failure = HOME_FAIL_DEGENERATE;
+                    return HOME_OK;
+                }
+    }
     if (n_in < cfg->min_inliers) { result->failure = HOME_FAIL_FEW_INLIERS; return HOME_OK; }
     result->failure = HOME_FAIL_NONE;
     result->ok = 1;

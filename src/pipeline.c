@@ -89,6 +89,7 @@ static void fill_keypoints(const home_context *ctx, home__heap *heap, int sign, 
         const home__candidate *c = &heap->items[i];
         home_keypoint *kp = &out[i];
         kp->theta = (float)(c->theta_bin * (HOME__PI / n_theta));
+        if (kp->theta >= (float)HOME__PI) kp->theta = nextafterf((float)HOME__PI, 0.0f); /* [0, pi) */
         /* r in full-image px: scale up from the (possibly downscaled) Hough image and move to
          * the full image's centre */
         kp->r = (float)(ctx->hough_scale * (c->r_bin - centre_bin) * ctx->cfg.r_step +
