@@ -84,6 +84,7 @@ demo: all
 	@mkdir -p $(BUILD)/demo
 	$(RUNNER) $(BUILD)/bin/home-stab-clip --scene structured --frames 120 --shake 4 --rot 0.4 --pan 80 --seed 3 $(BUILD)/demo/shaky.y4m $(BUILD)/demo/truth.csv
 	$(RUNNER) $(BUILD)/bin/home-stab --lookahead 10 --side-by-side --csv $(BUILD)/demo/path.csv --plot $(BUILD)/demo/path.png $(BUILD)/demo/shaky.y4m $(BUILD)/demo/side_by_side.y4m
+	@python3 bench/stab/demo_jitter.py $(BUILD)/demo/truth.csv $(BUILD)/demo/path.csv 640 360
 	@echo "side by side (original | stabilised): $(BUILD)/demo/side_by_side.y4m"
 	@echo "camera path, raw (red) and smoothed (blue): $(BUILD)/demo/path.png; per frame: $(BUILD)/demo/path.csv"
 	$(RUNNER) $(BUILD)/bin/home-make-pair --p 25 --seed 7 $(BUILD)/demo/a.pgm $(BUILD)/demo/b.pgm > $(BUILD)/demo/truth.json

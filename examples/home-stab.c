@@ -33,7 +33,9 @@ static void usage(FILE *f)
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
             "                    its half-size copy (2: default from 320 px)\n"
             "  --side-by-side    write original | stabilised, twice as wide\n"
-            "  --csv FILE        per-frame raw and smoothed camera path\n"
+            "  --csv FILE        per frame: raw and smoothed camera path (tx, ty px, angle rad,\n"
+            "                    log scale), share of the correction applied, and the warp\n"
+            "                    (output pixel -> input pixel, affine, w00..w12)\n"
             "  --plot FILE.png   plot of the raw and smoothed path\n"
             "  --quiet           no progress on stderr\n"
             "Exit: 0 ok; 1 input ended with a malformed or truncated frame (the frames before it\n"
@@ -105,10 +107,11 @@ static int write_output(app *ap, const home_stab_output *o)
         return -1;
     }
     if (ap->csv)
-        fprintf(ap->csv, "%ld,%s,%d,%.4f,%.4f,%.6f,%.6f,%.4f,%.4f,%.6f,%.6f,%.4f\n", o->frame,
-                status_name(o->motion_status), ap->inliers[o->frame % ap->ring_len], o->raw.tx,
+        fprintf(ap->csv, "%ld,%s,%d,%.4f,%.4f,%.6f,%.6f,%.4f,%.4f,%.6f,%.6f,%.4f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+                o->frame, status_name(o->motion_status), ap->inliers[o->frame % ap->ring_len], o->raw.tx,
                 o->raw.ty, o->raw.angle, o->raw.log_scale, o->smooth.tx, o->smooth.ty,
-                o->smooth.angle, o->smooth.log_scale, o->correction_used);
+                o->smooth.angle, o->smooth.log_scale, o->correction_used, o->warp[0], o->warp[1],
+                o->warp[2], o->warp[3], o->warp[4], o->warp[5]);
     stab_plot_add(&ap->plot, &o->raw, &o->smooth);
     ap->written++;
     return 0;
@@ -200,7 +203,7 @@ int main(int argc, char **argv)
     if (csv_path) {
         if (!(ap.csv = fopen(csv_path, "w"))) { fprintf(stderr, "home-stab: cannot write %s\n", csv_path); return 2; }
         fprintf(ap.csv, "frame,status,inliers,raw_tx,raw_ty,raw_angle,raw_log_scale,smooth_tx,"
-                        "smooth_ty,smooth_angle,smooth_log_scale,correction_used\n");
+                        "smooth_ty,smooth_angle,smooth_log_scale,correction_used,w00,w01,w02,w10,w11,w12\n");
     }
     y4m_write_header(ap.out, &ap.info, ap.side_by_side ? 2 * ap.info.width : ap.info.width);
 
