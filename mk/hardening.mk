@@ -15,7 +15,7 @@ FUZZ_SUPPORT := $(SUPPORT_OBJ) $(BUILD)/obj/examples/y4m.o
 BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
 TEST_BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
 
-$(HARD_TESTS): $(HARD_TEST_OBJ) $(FUZZ_SUPPORT) $(LIB)
+$(HARD_TESTS): $(HARD_TEST_OBJ) $(BUILD)/obj/tests/test_runner.o $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) -pthread
 

@@ -7,7 +7,7 @@ TEST_BINS += $(REFINE_TESTS)
 # `all` expands BINS before this file is read: name the targets explicitly
 all: $(REFINE_TESTS) $(REFINE_PAIR)
 
-$(REFINE_TESTS): $(BUILD)/obj/tests/test_refine.o $(SUPPORT_OBJ) $(LIB)
+$(REFINE_TESTS): $(BUILD)/obj/tests/test_refine.o $(BUILD)/obj/tests/test_runner.o $(SUPPORT_OBJ) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 

@@ -20,7 +20,7 @@ $(BUILD)/obj/tests/stab/test_stab.o: tests/test_stab.c include/home_stab.h port/
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) -Isrc -Iport -DHOME_STAB_TESTS -c $< -o $@
 
-$(BUILD)/bin/home-stab-tests: $(BUILD)/obj/tests/stab/test_stab.o $(STAB_SUPPORT) $(LIB)
+$(BUILD)/bin/home-stab-tests: $(BUILD)/obj/tests/stab/test_stab.o $(BUILD)/obj/tests/test_runner.o $(STAB_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 

@@ -16,7 +16,6 @@
 #include <stdint.h>
 #include <string.h>
 
-int test_failures;
 
 #define W 64
 #define H 64
@@ -333,25 +332,14 @@ static void test_refusals_leave_context_usable(void)
 #define HARD_DECLARE(name) void test_##name(void);
 HARD_TESTS_MORE(HARD_DECLARE)
 #define HARD_ENTRY(name) {#name, test_##name},
-static const struct { const char *name; void (*fn)(void); } tests[] = {HARD_TEST_LIST(HARD_ENTRY)};
+static const test_case tests[] = {HARD_TEST_LIST(HARD_ENTRY)};
 
 int main(int argc, char **argv)
 {
-    int passed = 0, failed = 0, k;
-    size_t i;
+    int k;
     if (argc == 2 && !strcmp(argv[1], "--list")) {
         for (k = 0; k < ROW_COUNT; k++) printf("%-36s %d\n", table[k].name, table[k].expect);
         return 0;
     }
-    for (i = 0; i < sizeof tests / sizeof tests[0]; i++) {
-        int before = test_failures, selected = argc < 2;
-        for (k = 1; k < argc; k++) selected |= !strcmp(argv[k], tests[i].name);
-        if (!selected) continue;
-        tests[i].fn();
-        if (test_failures == before) { passed++; printf("ok   %s\n", tests[i].name); }
-        else { failed++; printf("FAIL %s\n", tests[i].name); }
-        fflush(stdout);
-    }
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed ? 1 : 0;
+    return test_run(tests, sizeof tests / sizeof tests[0], "", argc, argv);
 }

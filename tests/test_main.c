@@ -7,7 +7,6 @@
 #include <stdint.h>
 #include <string.h>
 
-int test_failures;
 
 #define TEST_LIST(X) \
     X(config_defaults) X(arena_layout) X(heap_keeps_top_k) X(hough_edge_extremum) \
@@ -19,7 +18,7 @@ int test_failures;
 #define DECLARE(name) void test_##name(void);
 TEST_LIST(DECLARE)
 #define ENTRY(name) {#name, test_##name},
-static const struct { const char *name; void (*fn)(void); } tests[] = {TEST_LIST(ENTRY)};
+static const test_case tests[] = {TEST_LIST(ENTRY)};
 
 /* One static arena shared by the tests (the library itself never allocates). */
 static union { unsigned char bytes[24u << 20]; double align; } arena;
@@ -58,17 +57,5 @@ void test_map_line(const double *h, int width, int height, double theta, double 
 
 int main(int argc, char **argv)
 {
-    int passed = 0, failed = 0;
-    size_t i;
-    for (i = 0; i < sizeof tests / sizeof tests[0]; i++) {
-        int before = test_failures, k, selected = argc < 2;
-        for (k = 1; k < argc; k++) selected |= !strcmp(argv[k], tests[i].name);
-        if (!selected) continue;
-        tests[i].fn();
-        if (test_failures == before) { passed++; printf("ok   %s\n", tests[i].name); }
-        else { failed++; printf("FAIL %s\n", tests[i].name); }
-        fflush(stdout);
-    }
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed ? 1 : 0;
+    return test_run(tests, sizeof tests / sizeof tests[0], "", argc, argv);
 }

@@ -9,7 +9,6 @@
 #include <stdint.h>
 #include <string.h>
 
-int test_failures;
 
 #define IMG_W 640
 #define IMG_H 360
@@ -535,21 +534,9 @@ void test_refine_bad_inputs(void)
     X(refine_bad_inputs)
 
 #define ENTRY(name) {#name, test_##name},
-static const struct { const char *name; void (*fn)(void); } tests[] = {TEST_LIST(ENTRY)};
+static const test_case tests[] = {TEST_LIST(ENTRY)};
 
 int main(int argc, char **argv)
 {
-    int passed = 0, failed = 0;
-    size_t i;
-    for (i = 0; i < sizeof tests / sizeof tests[0]; i++) {
-        int before = test_failures, k, selected = argc < 2;
-        for (k = 1; k < argc; k++) selected |= !strcmp(argv[k], tests[i].name);
-        if (!selected) continue;
-        tests[i].fn();
-        if (test_failures == before) { passed++; printf("ok   %s\n", tests[i].name); }
-        else { failed++; printf("FAIL %s\n", tests[i].name); }
-        fflush(stdout);
-    }
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed ? 1 : 0;
+    return test_run(tests, sizeof tests / sizeof tests[0], "", argc, argv);
 }

@@ -13,7 +13,6 @@
 #include <stdio.h>
 #include <string.h>
 
-int test_failures;
 
 #define CW 256
 #define CH 144
@@ -465,23 +464,11 @@ static void test_api_contract(void)
     X(warp_formats_agree) X(warp_backends_identical) X(jitter_reduced_causal) X(lookahead_latency_and_gain) \
     X(downscaled_registration) X(hold_on_failure) X(implausible_jump_held) X(deterministic)
 #define ENTRY(name) {#name, test_##name},
-static const struct { const char *name; void (*fn)(void); } tests[] = {STAB_TESTS(ENTRY)};
+static const test_case tests[] = {STAB_TESTS(ENTRY)};
 
 int main(int argc, char **argv)
 {
-    int passed = 0, failed = 0;
-    size_t i;
-    for (i = 0; i < sizeof tests / sizeof tests[0]; i++) {
-        int before = test_failures, k, selected = argc < 2;
-        for (k = 1; k < argc; k++) selected |= !strcmp(argv[k], tests[i].name);
-        if (!selected) continue;
-        tests[i].fn();
-        if (test_failures == before) { passed++; printf("ok   stab_%s\n", tests[i].name); }
-        else { failed++; printf("FAIL stab_%s\n", tests[i].name); }
-        fflush(stdout);
-    }
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed ? 1 : 0;
+    return test_run(tests, sizeof tests / sizeof tests[0], "stab_", argc, argv);
 }
 #else
 typedef int home_stab_tests_not_built; /* ISO C forbids an empty translation unit */
