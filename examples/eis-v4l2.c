@@ -151,16 +151,23 @@ static void camera_close(camera *c)
     c->fd = -1;
 }
 
+/* A cleared mmap buffer descriptor of c's type (planes attached for multi-planar). */
+static void describe_buffer(const camera *c, unsigned index, struct v4l2_buffer *buf,
+                            struct v4l2_plane *planes)
+{
+    memset(buf, 0, sizeof *buf);
+    memset(planes, 0, MAX_PLANES * sizeof *planes);
+    buf->type = c->type;
+    buf->memory = V4L2_MEMORY_MMAP;
+    buf->index = index;
+    if (c->mplane) { buf->m.planes = planes; buf->length = (uint32_t)c->n_planes; }
+}
+
 static int queue_buffer(camera *c, unsigned index)
 {
     struct v4l2_buffer buf;
     struct v4l2_plane planes[MAX_PLANES];
-    memset(&buf, 0, sizeof buf);
-    memset(planes, 0, sizeof planes);
-    buf.type = c->type;
-    buf.memory = V4L2_MEMORY_MMAP;
-    buf.index = index;
-    if (c->mplane) { buf.m.planes = planes; buf.length = (uint32_t)c->n_planes; }
+    describe_buffer(c, index, &buf, planes);
     return xioctl(c->fd, VIDIOC_QBUF, &buf);
 }
 
@@ -244,12 +251,7 @@ static int camera_open(camera *c, const options *o)
     for (b = 0; b < req.count; b++) {
         struct v4l2_buffer buf;
         struct v4l2_plane planes[MAX_PLANES];
-        memset(&buf, 0, sizeof buf);
-        memset(planes, 0, sizeof planes);
-        buf.type = c->type;
-        buf.memory = V4L2_MEMORY_MMAP;
-        buf.index = b;
-        if (c->mplane) { buf.m.planes = planes; buf.length = (uint32_t)c->n_planes; }
+        describe_buffer(c, b, &buf, planes);
         if (xioctl(c->fd, VIDIOC_QUERYBUF, &buf)) { fprintf(stderr, "eis-v4l2: VIDIOC_QUERYBUF: %s\n", strerror(errno)); return -1; }
         c->n_buffers = b + 1;
         for (p = 0; p < c->n_planes; p++) {
@@ -464,11 +466,7 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
-        memset(&buf, 0, sizeof buf);
-        memset(planes, 0, sizeof planes);
-        buf.type = cam.type;
-        buf.memory = V4L2_MEMORY_MMAP;
-        if (cam.mplane) { buf.m.planes = planes; buf.length = (uint32_t)cam.n_planes; }
+        describe_buffer(&cam, 0, &buf, planes);
         if (xioctl(cam.fd, VIDIOC_DQBUF, &buf)) {
             if (errno == EAGAIN) continue;                     /* spurious wake-up */
             if (errno == EIO) { skipped++; continue; }         /* transient; the driver requeues */
