@@ -3,7 +3,14 @@
 #ifndef HOME_TEST_H
 #define HOME_TEST_H
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
+#include "home.h"
+
+/* The first HOME_ARENA_ALIGN-aligned byte of a static buffer, and the bytes usable from there:
+ * C99 aligns a buffer only as much as its widest member type (8 bytes on 32-bit ARM). */
+#define ALIGNED_ARENA(buf) ((unsigned char *)(buf) + (-(uintptr_t)(buf) & (HOME_ARENA_ALIGN - 1)))
+#define ALIGNED_BYTES(buf) (sizeof(buf) - HOME_ARENA_ALIGN)
 
 extern int test_failures;
 

@@ -3,11 +3,6 @@
 #define HOME_TEST_BAD_INPUT_H
 #include "home.h"
 
-/* The first HOME_ARENA_ALIGN-aligned byte of a static buffer, and the bytes usable from there:
- * C99 aligns a buffer only as much as its widest member type (8 bytes on 32-bit ARM). */
-#define ALIGNED_ARENA(buf) ((unsigned char *)(buf) + (-(uintptr_t)(buf) & (HOME_ARENA_ALIGN - 1)))
-#define ALIGNED_BYTES(buf) (sizeof(buf) - HOME_ARENA_ALIGN)
-
 /* Same keypoints, field by field (struct padding is never compared). */
 int same_features(const home_features *a, const home_features *b);
 #define HARD_TESTS_MORE(X) \

@@ -29,13 +29,8 @@ home_context *test_context(int width, int height, const home_config *override_cf
     home_context *ctx = NULL;
     if (override_cfg) cfg = *override_cfg;
     else if (home_default_config(&cfg, width, height) != HOME_OK) return NULL;
-    /* C99 cannot ask for 16-byte alignment of a static (armv7 gives 8): align at run time */
-    {
-        unsigned char *base = (unsigned char *)(((uintptr_t)arena.bytes + HOME_ARENA_ALIGN - 1) &
-                                                ~(uintptr_t)(HOME_ARENA_ALIGN - 1));
-        size_t room = sizeof arena.bytes - (size_t)(base - arena.bytes);
-        if (home_init(&ctx, &cfg, base, room, NULL) != HOME_OK) return NULL;
-    }
+    if (home_init(&ctx, &cfg, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL) != HOME_OK)
+        return NULL;
     return ctx;
 }
 

@@ -23,7 +23,7 @@ static home_context *context(const home_config *override_cfg)
     home_context *ctx = NULL;
     if (override_cfg) cfg = *override_cfg;
     else home_default_config(&cfg, IMG_W, IMG_H);
-    if (home_init(&ctx, &cfg, arena.bytes, sizeof arena.bytes, NULL) != HOME_OK) return NULL;
+    if (home_init(&ctx, &cfg, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL) != HOME_OK) return NULL;
     return ctx;
 }
 

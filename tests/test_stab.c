@@ -29,7 +29,7 @@ static home_stab *make_stab(int lookahead, int downscale)
     home_stab_default_config(&cfg, CW, CH);
     cfg.lookahead = lookahead;
     cfg.downscale = downscale;
-    if (home_stab_init(&st, &cfg, arena.bytes, sizeof arena.bytes, NULL) != HOME_OK) return NULL;
+    if (home_stab_init(&st, &cfg, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL) != HOME_OK) return NULL;
     return st;
 }
 
@@ -422,17 +422,18 @@ static void test_api_contract(void)
     home_stab *st = NULL;
     home_stab_output o;
     home_stab_image im, small;
+    unsigned char *base = ALIGNED_ARENA(arena.bytes);
     size_t need = 0, size;
     double affine[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, proj[9] = {1, 0, 0, 0, 1, 0, 1e-4, 0, 1};
     double far[9] = {1, 0, 900, 0, 1, 0, 0, 0, 1}, nan_map[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     CHECK_EQ_INT(home_stab_default_config(&cfg, CW, CH), HOME_OK);
     CHECK_EQ_INT(home_stab_validate_config(&cfg), HOME_OK);
     size = home_stab_arena_size(&cfg);
-    CHECK(size > 0 && size < sizeof arena.bytes);
-    CHECK_EQ_INT(home_stab_init(&st, &cfg, arena.bytes, size - 1, &need), HOME_E_ARENA_SMALL);
+    CHECK(size > 0 && size < ALIGNED_BYTES(arena.bytes));
+    CHECK_EQ_INT(home_stab_init(&st, &cfg, base, size - 1, &need), HOME_E_ARENA_SMALL);
     CHECK_EQ_INT(need, size);
-    CHECK_EQ_INT(home_stab_init(&st, &cfg, arena.bytes + 1, size + 16, NULL), HOME_E_ARENA_ALIGN);
-    CHECK_EQ_INT(home_stab_init(&st, NULL, arena.bytes, size, NULL), HOME_E_NULL);
+    CHECK_EQ_INT(home_stab_init(&st, &cfg, base + 1, size + 16, NULL), HOME_E_ARENA_ALIGN);
+    CHECK_EQ_INT(home_stab_init(&st, NULL, base, size, NULL), HOME_E_NULL);
     bad = cfg; bad.width = CW + 1; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_SIZE);
     bad = cfg; bad.margin = 0.5f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.smoothing = NAN; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
@@ -440,7 +441,7 @@ static void test_api_contract(void)
     bad = cfg; bad.downscale = 3; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.downscale = 8; CHECK(home_stab_validate_config(&bad) != HOME_OK);
     CHECK_EQ_INT(home_stab_arena_size(&bad), 0);
-    CHECK_EQ_INT(home_stab_init(&st, &cfg, arena.bytes, size, NULL), HOME_OK);
+    CHECK_EQ_INT(home_stab_init(&st, &cfg, base, size, NULL), HOME_OK);
     grey_image(buf, &im);
     CHECK_EQ_INT(home_stab_push(st, NULL, &o), HOME_E_NULL);
     CHECK_EQ_INT(home_stab_push(NULL, &im, &o), HOME_E_NULL);
@@ -454,7 +455,7 @@ static void test_api_contract(void)
     CHECK_EQ_INT(home_stab_warp(nan_map, &im, &im), HOME_E_CONFIG);
     small = im; small.height = CH - 2; CHECK_EQ_INT(home_stab_warp(affine, &im, &small), HOME_E_MISMATCH);
     /* a garbage-filled handle is refused, not followed */
-    memset(arena.bytes, 0x5a, 4096);
+    memset(base, 0x5a, 4096);
     CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_E_STATE);
     CHECK_EQ_INT(home_stab_flush(st, &o), HOME_E_STATE);
 }
