@@ -110,8 +110,9 @@ static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::v
 }
 
 // Only the per-frame work, n times, for instruction counting under callgrind:
-//   home-bench --frames orb|home N [downscale [theta_window [threshold_start]]]
-static int count_frames(const char *method, int n, int downscale, int window, float t0) {
+//   home-bench --frames orb|home N [downscale [theta_window [threshold_start [theta_bins [keypoints]]]]]
+static int count_frames(const char *method, int n, int downscale, int window, float t0, int theta_bins,
+                        int keypoints) {
     const int w = 640, h = 360;
     double ident[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, hw[9];
     synth_rng rng;
@@ -130,6 +131,8 @@ static int count_frames(const char *method, int n, int downscale, int window, fl
     cfg.hough_downscale = downscale;
     cfg.match_theta_window = window;
     if (t0 > 0) cfg.threshold_start = t0;
+    if (theta_bins > 0) cfg.theta_bins = theta_bins;
+    if (keypoints > 0) cfg.keypoints_per_sign = keypoints;
     size_t bytes = home_arena_size(&cfg);
     std::vector<unsigned char> mem(bytes + HOME_ARENA_ALIGN);
     void *arena = (void *)(((uintptr_t)mem.data() + HOME_ARENA_ALIGN - 1) & ~(uintptr_t)(HOME_ARENA_ALIGN - 1));
@@ -148,7 +151,8 @@ static int count_frames(const char *method, int n, int downscale, int window, fl
 int main(int argc, char **argv) {
     if (argc > 3 && std::string(argv[1]) == "--frames")
         return count_frames(argv[2], atoi(argv[3]), argc > 4 ? atoi(argv[4]) : 1,
-                            argc > 5 ? atoi(argv[5]) : 0, argc > 6 ? (float)atof(argv[6]) : 0.0f);
+                            argc > 5 ? atoi(argv[5]) : 0, argc > 6 ? (float)atof(argv[6]) : 0.0f,
+                            argc > 7 ? atoi(argv[7]) : 0, argc > 8 ? atoi(argv[8]) : 0);
     int runs = argc > 1 ? atoi(argv[1]) : 41;
     cv::setNumThreads(1);  // single thread, like libhome
     static const int sizes[][2] = {{640, 360}, {1280, 720}};

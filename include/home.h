@@ -83,12 +83,14 @@ typedef struct home_config {
     /* photometric refinement of HOME's H (home_refine() below); refine_levels = 0 turns it off */
     int refine_levels;        /* pyramid levels, 1..HOME_REFINE_MAX_LEVELS; default 3 */
     int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
-    float refine_trust_px;    /* largest corner motion from HOME's H accepted, px; default 6 */
+    float refine_trust_px;    /* largest corner motion from HOME's H accepted, in px of the
+                                 Hough image (x hough_downscale in the image); default 6 */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
-    int hough_downscale;      /* 1: Hough transform of the image itself; 2: of its 2x2-box
-                                 downscaled copy (FAST only): ~4x less Hough work, for video on
-                                 small cores; r bins are then 2*r_step px of the full image */
+    int hough_downscale;      /* 1: Hough transform of the image itself; 2 or 4: of its 2x2- or
+                                 4x4-box downscaled copy (FAST only): 4x or 16x less Hough work,
+                                 for video on small cores (the photometric refinement restores
+                                 full-resolution precision); r bins are then ds*r_step px */
     int match_theta_window;   /* video motion prior: 0 = off (default, still pairs); N > 0 =
                                  a keypoint is only compared with keypoints whose theta lies
                                  within N bins of its own (the frame rotates less than that) */
@@ -169,7 +171,7 @@ enum home_refine_status {
     HOME_REFINE_NOT_CONVERGED,    /* the finest level used hit refine_iterations */
     HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above 0.5 px (predicted, or from
                                      two interleaved halves of the points) */
-    HOME_REFINE_OUTSIDE_TRUST,    /* a corner moved more than refine_trust_px from HOME's H */
+    HOME_REFINE_OUTSIDE_TRUST,    /* a corner left the trust region (refine_trust_px) */
     HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
     HOME_REFINE_LOW_CORRELATION   /* HOME failed and the refinement cannot vouch (rule below) */
 };

@@ -73,7 +73,7 @@ static int r_bins_for(int width, int height, float r_step)
 /* Size of the image the Hough transform sees (after hough_downscale). */
 void home__hough_size(const home_config *cfg, int *width, int *height)
 {
-    int ds = cfg->hough_downscale == 2 ? 2 : 1;
+    int ds = cfg->hough_downscale == 2 || cfg->hough_downscale == 4 ? cfg->hough_downscale : 1;
     *width = cfg->width / ds;
     *height = cfg->height / ds;
 }
@@ -119,8 +119,9 @@ int home_validate_config(const home_config *cfg)
     if (cfg->hough_method != HOME_HOUGH_FAST && cfg->hough_method != HOME_HOUGH_EXACT)
         return HOME_E_CONFIG;
     if (cfg->hough_downscale != 1 &&
-        (cfg->hough_downscale != 2 || cfg->hough_method != HOME_HOUGH_FAST ||
-         cfg->width / 2 < HOME_MIN_SIDE || cfg->height / 2 < HOME_MIN_SIDE))
+        ((cfg->hough_downscale != 2 && cfg->hough_downscale != 4) ||
+         cfg->hough_method != HOME_HOUGH_FAST || cfg->width / cfg->hough_downscale < HOME_MIN_SIDE ||
+         cfg->height / cfg->hough_downscale < HOME_MIN_SIDE))
         return HOME_E_CONFIG;
     if (cfg->match_theta_window < 0 || cfg->match_theta_window > cfg->theta_bins)
         return HOME_E_CONFIG;
@@ -135,7 +136,7 @@ uint32_t home__config_id(const home_config *cfg)
     float ffields[2];
     const unsigned char *p;
     size_t i;
-    fields[0] = cfg->width + (cfg->hough_downscale == 2 ? 1 << 20 : 0);
+    fields[0] = cfg->width + (cfg->hough_downscale / 2 << 20); /* 1, 2, 4 -> 0, 1, 2 */
     fields[1] = cfg->height; fields[2] = cfg->theta_bins;
     fields[3] = home__r_bins(cfg); fields[4] = cfg->keypoints_per_sign; fields[5] = cfg->wrap_band;
     ffields[0] = cfg->r_step; ffields[1] = cfg->smooth_sigma;
@@ -249,7 +250,7 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
     ctx->cfg = *cfg;
     ctx->r_bins = home__r_bins(cfg);
     home__hough_size(cfg, &ctx->hough_w, &ctx->hough_h);
-    ctx->hough_scale = cfg->hough_downscale == 2 ? 2 : 1;
+    ctx->hough_scale = cfg->hough_downscale;
     /* the Hough image covers full-image columns [0, scale * hough_w): its centre sits at
      * (scale * hough_w - 1) / 2, i.e. this far from the full image's centre */
     ctx->hough_dx = 0.5 * (ctx->hough_scale * ctx->hough_w - cfg->width);

@@ -41,20 +41,33 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
     }
 }
 
-/* Copy the image (2x2-box downscaled when hough_downscale is 2) into the zero-padded buffers
+/* Copy the image (box-downscaled when hough_downscale is 2 or 4) into the zero-padded buffers
  * (HOME__RADON_BLOCK columns each side) used by the shear-and-add kernel: img_n as is, img_t
  * transposed from it. */
 static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
 {
     const int width = ctx->hough_w, height = ctx->hough_h, pad = HOME__RADON_BLOCK;
+    const int ds = ctx->hough_scale;
     int x, y;
     for (y = 0; y < height; y++) {
         uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
         memset(row, 0, (size_t)pad);
-        if (ctx->hough_scale == 2) {
-            const uint8_t *s0 = image + (ptrdiff_t)(2 * y) * stride, *s1 = s0 + stride;
-            for (x = 0; x < width; x++)
-                row[pad + x] = (uint8_t)((s0[2 * x] + s0[2 * x + 1] + s1[2 * x] + s1[2 * x + 1] + 2) >> 2);
+        if (ds > 1) {
+            /* box average, rounded: ds*ds is 4 or 16, so the division is a shift; the ds rows
+             * are summed in 4-byte groups into line_sum (at least hough_w long) */
+            const int shift = ds == 2 ? 2 : 4;
+            int32_t *acc = ctx->line_sum;
+            int v;
+            for (x = 0; x < width; x++) acc[x] = 0;
+            for (v = 0; v < ds; v++) {
+                const uint8_t *src = image + (ptrdiff_t)(ds * y + v) * stride;
+                if (ds == 2)
+                    for (x = 0; x < width; x++) acc[x] += src[2 * x] + src[2 * x + 1];
+                else
+                    for (x = 0; x < width; x++)
+                        acc[x] += src[4 * x] + src[4 * x + 1] + src[4 * x + 2] + src[4 * x + 3];
+            }
+            for (x = 0; x < width; x++) row[pad + x] = (uint8_t)((acc[x] + (1 << (shift - 1))) >> shift);
         } else {
             memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
         }
@@ -94,13 +107,15 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
     const uint8_t *base = flip ? img + (ptrdiff_t)(rows - 1) * img_stride : img;
     const ptrdiff_t stride = flip ? -img_stride : img_stride;
     const double centre = 0.5 * (rows - 1), inv_abs_a = 1.0 / fabs(a);
+    const double t_processed = flip ? -t : t;
     int32_t *left = ctx->edge_prefix, *right = ctx->edge_prefix + rows + 1;
     int32_t *sum = ctx->line_sum;
     float *line = ctx->line_j;
     int p, v, j, s_min, s_max, j0, n, n_blocks, blk, i;
 
     for (p = 0; p < rows; p++) {
-        double x = t * ((flip ? rows - 1 - p : p) - centre) + 0.5;
+        /* row rows-1-p in original order: t (centre - p) == -t (p - centre) exactly */
+        double x = t_processed * (p - centre) + 0.5;
         int k = (int)x;
         ctx->shift[p] = (int16_t)(k > x ? k - 1 : k); /* floor without a libm call */
     }
@@ -134,10 +149,20 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
     {
         const int32_t *fr = ctx->first_row, right_total = right[rows];
         const int span = s_max - s_min + 1;
-        const double end_scale = flip ? -2.0 * b : 2.0 * b; /* [I] in original row order */
+        /* lines through every row (entry 0, exit rows - 1): no border term, and their end
+         * pixels lie on two contiguous rows */
+        const int mid_lo = -s_min - j0, mid_hi = cols - s_max - j0; /* [mid_lo, mid_hi) */
+        const uint8_t *first_row_px = base + ctx->shift[0];
+        const uint8_t *last_row_px = base + (ptrdiff_t)(rows - 1) * stride + ctx->shift[rows - 1];
         for (i = 0; i < n; i++) {
             int v_entry, v_after, entry, after;
             j = j0 + i;
+            if (i == mid_lo && mid_lo < mid_hi) {
+                for (; i < mid_hi; i++)
+                    line[i] = (float)(last_row_px[j0 + i] - first_row_px[j0 + i]);
+                if (i >= n) break;
+                j = j0 + i;
+            }
             v_entry = -j - s_min;                   /* rows before the entry: left of the image */
             v_after = cols - j - s_min;             /* rows from `after` on: right of it */
             entry = fr[v_entry < 0 ? 0 : v_entry > span ? span : v_entry];
@@ -146,7 +171,7 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
             if (entry < after) {
                 int first_value = base[(ptrdiff_t)entry * stride + j + ctx->shift[entry]];
                 int last_value = base[(ptrdiff_t)(after - 1) * stride + j + ctx->shift[after - 1]];
-                line[i] = (float)(end_scale * (last_value - first_value));
+                line[i] = (float)(last_value - first_value); /* exact: |.| <= 255 */
             } else {
                 line[i] = 0.0f;
             }
@@ -154,38 +179,41 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
     }
     /* J on the intercept grid (in place over the end terms), then resampled to the r axis */
     {
-        const double d_scale = inv_abs_a / a;
+        const float d_scale = (float)(inv_abs_a / a);
+        const float end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
         for (i = 1; i < n - 1; i++)
-            line[i] = (float)(d_scale * (double)(sum[i + 1] - sum[i - 1]) + inv_abs_a * line[i]);
+            line[i] = d_scale * (float)(sum[i + 1] - sum[i - 1]) + end_scale * line[i];
         line[0] = line[n - 1] = 0.0f;
     }
     {
-        /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0 */
+        /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0; the
+         * bins with jf in [0, n - 1) are a contiguous range (jf is monotonic in i), zero elsewhere */
         const double dj = ctx->cfg.r_step / a;
         const double jf0 = -0.5 * (ctx->r_bins - 1) * dj + 0.5 * (cols - 1) - j0;
-        /* bins whose jf falls in [0, n - 1): a contiguous range (|dj| > 0), zero elsewhere */
-        double lo = dj > 0 ? -jf0 / dj : (n - 1 - jf0) / dj;
-        double hi = dj > 0 ? (n - 1 - jf0) / dj : -jf0 / dj;
-        int i_lo = lo < 0 ? 0 : (int)lo, i_hi = hi >= ctx->r_bins ? ctx->r_bins : (int)hi + 1;
-        for (i = 0; i < ctx->r_bins; i++) {
-            double jf = jf0 + i * dj, f;
-            int k;
-            if (i == i_lo) {                   /* the interior, without per-bin range tests */
-                for (; i < i_hi; i++) {
-                    jf = jf0 + i * dj;
-                    if (!(jf >= 0.0) || jf >= (double)(n - 1)) break;
-                    k = (int)jf;
-                    f = jf - k;
-                    out[i] = (float)(line[k] + f * (line[k + 1] - line[k]));
-                }
-                if (i >= ctx->r_bins) break;
-                jf = jf0 + i * dj;
-            }
-            if (!(jf >= 0.0) || jf >= (double)(n - 1)) { out[i] = 0.0f; continue; }
-            k = (int)jf; /* jf >= 0: truncation is floor */
-            f = jf - k;
-            out[i] = (float)(line[k] + f * (line[k + 1] - line[k]));
+        const double last = (double)(n - 1);
+        const int r_bins = ctx->r_bins;
+        double lo = dj > 0 ? -jf0 / dj : (last - jf0) / dj;
+        int i_lo = lo <= 0 ? 0 : lo >= r_bins ? r_bins : (int)lo, i_hi;
+#define IN_LINE(bin) (jf0 + (bin) * dj >= 0.0 && jf0 + (bin) * dj < last)
+        /* the estimate is within a bin or two: settle it with the exact test */
+        while (i_lo > 0 && IN_LINE(i_lo - 1)) i_lo--;
+        while (i_lo < r_bins && !IN_LINE(i_lo)) i_lo++;
+        i_hi = i_lo;
+        if (i_lo < r_bins) {
+            double hi = dj > 0 ? (last - jf0) / dj : -jf0 / dj;
+            i_hi = hi <= i_lo ? i_lo + 1 : hi >= r_bins ? r_bins : (int)hi;
+            while (i_hi < r_bins && IN_LINE(i_hi)) i_hi++;
+            while (i_hi > i_lo + 1 && !IN_LINE(i_hi - 1)) i_hi--;
         }
+#undef IN_LINE
+        for (i = 0; i < i_lo; i++) out[i] = 0.0f;
+        for (; i < i_hi; i++) {
+            double jf = jf0 + i * dj;
+            int k = (int)jf; /* jf >= 0: truncation is floor */
+            float f = (float)(jf - k);
+            out[i] = line[k] + f * (line[k + 1] - line[k]);
+        }
+        for (; i < r_bins; i++) out[i] = 0.0f;
     }
 }
 

@@ -20,7 +20,7 @@
  * converged within its cap, the estimate is well conditioned (the corners' standard deviation
  * predicted by the Fisher information, and the disagreement of two interleaved halves of the
  * points, which also sees noise in the template's own gradients, both under 0.5 px), no corner
- * moved more than refine_trust_px, and the robust photometric error over the points both
+ * moved more than refine_trust_px (times hough_downscale), and the robust photometric error over the points both
  * warps keep went down. Otherwise HOME's H stays. Noise-only templates never converge.
  *
  * Coordinates: normalised u = (x - cx) / f, v = (y - cy) / f with cx, cy the image centre and
@@ -631,7 +631,8 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return;
     }
-    if (max_corner_distance(&s, h1, h0) > ctx->cfg.refine_trust_px) {
+    /* HOME's own precision scales with the Hough image's pixel: so does the trust region */
+    if (max_corner_distance(&s, h1, h0) > ctx->cfg.refine_trust_px * ctx->hough_scale) {
         result->refine_status = HOME_REFINE_OUTSIDE_TRUST;
         return;
     }
