@@ -9,10 +9,20 @@
 #include "home.h"
 #include <math.h>
 
-/* Images stay small so one execution is fast: sides 32..56 and 16..48 theta bins unless the
- * fuzzer picks raw values; buffers allow up to 96 px. */
+/* Executions must be fast (millions per campaign, issue 7), so configs are tiny unless all three
+ * FLAG_LARGE bits are set (one random input in eight): tiny = sides 32..36, 16..24 theta bins,
+ * 8..40 keypoints per sign and Hough images up to FZ_TINY_HOUGH_CELLS; large = sides 32..56,
+ * 16..48 bins, 8..200 keypoints, Hough images up to FZ_MAX_HOUGH_CELLS. Tiny configs still walk
+ * every entry point, the validation, the arena layout and both outcomes of a registration; the
+ * large ones keep the loop counts of bigger images in play. Buffers allow up to 96 px (raw
+ * sizes). */
+#define FZ_TINY_SIDE 36
+#define FZ_TINY_THETA 24
+#define FZ_TINY_KEYPOINTS 40
+#define FZ_TINY_HOUGH_CELLS (128 * 64)
 #define FZ_SMALL_SIDE 56
 #define FZ_SMALL_THETA 48
+#define FZ_SMALL_KEYPOINTS 200
 #define FZ_MAX_SIDE 96
 #define FZ_MAX_HOUGH_CELLS (256 * 200)
 #define FZ_MAX_STRIDE (FZ_MAX_SIDE + 16)
@@ -31,7 +41,8 @@ enum {
     FLAG_CLOCK = 1 << 9,         /* a timing hook is set */
     FLAG_REFINE = 1 << 10,       /* home_refine() from a fuzzed initial H */
     FLAG_EXACT = 1 << 11,        /* the exact (pixel by pixel) Hough method */
-    FLAG_HOUGH_HALF = 1 << 12    /* the Hough transform of a 2x2-downscaled copy */
+    FLAG_HOUGH_HALF = 1 << 12,   /* the Hough transform of a 2x2-downscaled copy */
+    FLAG_LARGE = 7 << 13         /* all three set: large sizes and counts (else tiny ones) */
 };
 
 static union { unsigned char bytes[FZ_ARENA_BYTES]; double align; } arena;
@@ -215,7 +226,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     home_context *ctx = NULL;
     home_result res, res2;
     size_t need, have, needed = 0;
-    int width, height, status, expect, s;
+    int large = (flags & FLAG_LARGE) == FLAG_LARGE, width, height, status, expect, s;
     ptrdiff_t stride_a, stride_b;
     unsigned char *base;
     uint8_t *img_a, *img_b;
@@ -225,16 +236,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         width = (int16_t)fz_u16(r);
         height = (int16_t)fz_u16(r);
     } else {
-        width = fz_range(r, HOME_MIN_SIDE, FZ_SMALL_SIDE);
-        height = fz_range(r, HOME_MIN_SIDE, FZ_SMALL_SIDE);
+        width = fz_range(r, HOME_MIN_SIDE, large ? FZ_SMALL_SIDE : FZ_TINY_SIDE);
+        height = fz_range(r, HOME_MIN_SIDE, large ? FZ_SMALL_SIDE : FZ_TINY_SIDE);
     }
     status = home_default_config(&cfg, width, height);
     expect = (width < HOME_MIN_SIDE || height < HOME_MIN_SIDE || width > HOME_MAX_SIDE ||
               height > HOME_MAX_SIDE) ? HOME_E_SIZE : HOME_OK;
     FZ_CHECK(status == expect);
-    cfg.theta_bins = fz_range(r, 16, FZ_SMALL_THETA); /* raw values come with FLAG_FUZZ_CONFIG */
+    /* raw values come with FLAG_FUZZ_CONFIG */
+    cfg.theta_bins = fz_range(r, 16, large ? FZ_SMALL_THETA : FZ_TINY_THETA);
     cfg.wrap_band = cfg.theta_bins / 18;
-    cfg.keypoints_per_sign = fz_range(r, 8, 200);
+    cfg.keypoints_per_sign = fz_range(r, 8, large ? FZ_SMALL_KEYPOINTS : FZ_TINY_KEYPOINTS);
     cfg.min_inliers = fz_range(r, 4, 30);
     cfg.simd = fz_range(r, HOME_SIMD_AUTO, HOME_SIMD_AVX2 + 1); /* uncompiled ones are refused */
     if (flags & FLAG_EXACT) cfg.hough_method = HOME_HOUGH_EXACT;
@@ -272,7 +284,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     {
         int hw = 0, hh = 0;
         FZ_CHECK(home_hough_size(ctx, &hw, &hh) == HOME_OK);
-        if ((long)hw * hh > FZ_MAX_HOUGH_CELLS) return 0;
+        if ((long)hw * hh > (large ? FZ_MAX_HOUGH_CELLS : FZ_TINY_HOUGH_CELLS)) return 0;
     }
 
     stride_a = stride_b = cfg.width;

@@ -6,8 +6,16 @@
 #include "home_stab.h"
 #include <math.h>
 
+/* Every pushed frame costs a Hough transform at HOME's 480 theta bins, so executions are kept
+ * short (issue 7): unless all three FLAG_LARGE bits are set (one random input in eight), frames
+ * are 32..36 px, 8..24 keypoints per sign and 0..2 frames are pushed (none: the config, arena,
+ * frame and warper checks alone); large inputs use 32..64 px, 8..150 keypoints, 1..5 frames. */
 #define FZ_SIDE_MAX 64
+#define FZ_TINY_SIDE 36
+#define FZ_TINY_KEYPOINTS 24
+#define FZ_TINY_FRAMES 2
 #define FZ_FRAMES_MAX 5
+#define FLAG_LARGE (7u << 13)
 #define FZ_PLANE_BYTES (2 * (FZ_SIDE_MAX + 8) * FZ_SIDE_MAX)
 #define FZ_ARENA_BYTES (8u << 20)
 
@@ -81,14 +89,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     home_stab_output out;
     uint8_t scene[64 * 64];
     size_t need, have;
-    int w = 2 * fz_range(r, HOME_MIN_SIDE / 2, FZ_SIDE_MAX / 2), h = 2 * fz_range(r, HOME_MIN_SIDE / 2, FZ_SIDE_MAX / 2);
+    int large = (flags & FLAG_LARGE) == FLAG_LARGE, side_max = large ? FZ_SIDE_MAX : FZ_TINY_SIDE;
+    int w = 2 * fz_range(r, HOME_MIN_SIDE / 2, side_max / 2), h = 2 * fz_range(r, HOME_MIN_SIDE / 2, side_max / 2);
     int s, k, n, fmt, pad, dx, dy, valid[FZ_FRAMES_MAX], pushed = 0;
     long last = -1;
 
     if (flags & 1) { w = (int16_t)fz_u16(r); h = (int16_t)fz_u16(r); }
     s = home_stab_default_config(&cfg, w, h);
     FZ_CHECK(is_status(s));
-    cfg.keypoints_per_sign = fz_range(r, 8, 150);
+    cfg.keypoints_per_sign = fz_range(r, 8, large ? 150 : FZ_TINY_KEYPOINTS);
     cfg.lookahead = fz_range(r, 0, 3);
     cfg.downscale = 1;
     if (flags & 2) {
@@ -136,8 +145,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     pad = fz_range(r, 0, 8);
     dx = fz_range(r, -3, 3);
     dy = fz_range(r, -3, 3);
-    n = fz_range(r, 1, FZ_FRAMES_MAX);
-    for (k = 0; k < n; k++) valid[k] = make_frame(r, &frames[k], k, fmt, cfg.width, cfg.height, pad, scene, dx, dy);
+    n = large ? fz_range(r, 1, FZ_FRAMES_MAX) : fz_range(r, 0, FZ_TINY_FRAMES);
+    /* frame 0 is made even when nothing is pushed: the warper's source */
+    for (k = 0; k < (n ? n : 1); k++) valid[k] = make_frame(r, &frames[k], k, fmt, cfg.width, cfg.height, pad, scene, dx, dy);
 
     for (k = 0; k < n; k++) {
         s = home_stab_push(stab, &frames[k], &out);
@@ -166,7 +176,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(k <= cfg.lookahead);
 
     /* the warper on any matrix: refused or done, never out of bounds */
-    if (pushed && valid[0]) {
+    if (valid[0]) {
         double m[9];
         home_stab_sim sim;
         for (k = 0; k < 9; k++) m[k] = (fz_u8(r) & 1) ? (double)fz_float_bits(r) : (k % 4 == 0);
@@ -184,7 +194,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         home_stab_sim_to_matrix(&sim, cfg.width, cfg.height, m);
     }
     FZ_CHECK(home_stab_reset(stab) == HOME_OK);
-    if (valid[0]) {
+    if (pushed && valid[0]) {
         FZ_CHECK(home_stab_push(stab, &frames[0], &out) == HOME_OK);
         FZ_CHECK(out.newest_status == HOME_STAB_MOTION_FIRST);
     }

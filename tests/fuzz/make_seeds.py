@@ -13,9 +13,14 @@ def u16(v):
     return struct.pack("<H", v & 0xFFFF)
 
 
-def api_seed(rng, flags, side=48, theta=40, shapes=10, shift=(3, -2)):
+# FLAG_LARGE of both harnesses: all three bits set selects the large size and count ranges (the
+# seeds below were written for them); without it sizes and counts are tiny (seed-tiny-*).
+LARGE = 0xE000
+
+
+def api_seed(rng, flags, side=48, theta=40, shapes=10, shift=(3, -2), large=True):
     """fuzz_api.c layout: flags, sizes, theta/keypoints/min-inliers, image recipe, shift."""
-    b = u16(flags)
+    b = u16(flags | (LARGE if large else 0))
     b += u16(side - 32) + u16(side - 32)          # width, height = 32 + v % 25
     b += u16(theta - 16) + u16(120 - 8) + u16(8)  # theta bins, keypoints 120, min inliers 12
     if flags & 0x08:                              # FLAG_STRIDE: padded rows for a and b
@@ -87,10 +92,10 @@ def main():
     stab = ROOT / "stab"
     stab.mkdir(parents=True, exist_ok=True)
 
-    def stab_seed(flags, side, lookahead, fmt, shift, frames, extra=b""):
+    def stab_seed(flags, side, lookahead, fmt, shift, frames, extra=b"", large=True, keypoints=120):
         """fuzz_stab.c layout: flags, sizes, keypoints, lookahead, scene, format, pad, shift, frames."""
-        b = u16(flags) + u16(side // 2 - 16) + u16(side // 2 - 16) + extra
-        b += u16(120 - 8) + u16(lookahead) + bytes([90]) + u16(8)
+        b = u16(flags | (LARGE if large else 0)) + u16(side // 2 - 16) + u16(side // 2 - 16) + extra
+        b += u16(keypoints - 8) + u16(lookahead) + bytes([90]) + u16(8)
         for _ in range(8):
             x0, y0 = rng.randrange(50), rng.randrange(50)
             b += u16(x0) + u16(y0) + u16(x0 + rng.randrange(4, 14)) + u16(y0 + rng.randrange(4, 14))
@@ -110,6 +115,26 @@ def main():
     }
     for name, data in stab_seeds.items():
         (stab / f"seed-{name}").write_bytes(data)
+
+    # tiny configs (the fast executions most of a campaign runs), from their own generator so the
+    # seeds above stay as they were
+    rng = random.Random(8)
+    tiny_api = {
+        "pair": api_seed(rng, 0x000, side=34, theta=20, shapes=8, shift=(2, -1), large=False),
+        "video-render": api_seed(rng, 0x120, side=32, theta=16, shapes=6, large=False),
+        "refine-corrupt": api_seed(rng, 0x440, side=36, theta=24, shapes=8, large=False)
+        + bytes([4]) + bytes(rng.randrange(256) for _ in range(64)),
+        "exact": api_seed(rng, 0x800, side=33, theta=18, shapes=8, large=False),
+    }
+    for name, data in tiny_api.items():
+        (api / f"seed-tiny-{name}").write_bytes(data)
+    tiny_stab = {
+        "grey": stab_seed(0, 32, 0, 5, (1, 1), 3, large=False, keypoints=24),
+        "i420-lookahead": stab_seed(0, 34, 1, 1, (1, -1), 3, large=False, keypoints=16),
+        "no-push": stab_seed(0, 32, 0, 5, (0, 0), 1, large=False, keypoints=8),
+    }
+    for name, data in tiny_stab.items():
+        (stab / f"seed-tiny-{name}").write_bytes(data)
 
 
 if __name__ == "__main__":
