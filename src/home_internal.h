@@ -148,11 +148,11 @@ int home__match_features(home_context *ctx, const home_features *a, const home_f
 /* homography.c */
 int home__estimate_homography(home_context *ctx, int n_matches, home_result *result);
 
-/* lm.c: minimise sum |e_i(p)|^2 over 8 parameters; e_i has 3 components. */
-typedef void (*home__residual_fn)(const void *user, int i, const double *p, double *e,
-                                  double *jac /* 3 x 8, row-major, may be NULL */);
-int home__lm_solve(double *p, int n, const int *index, home__residual_fn fn, const void *user,
-                   int max_iters);
+/* lm.c: minimise a sum of squares over 8 parameters. The problem supplies its cost and, when
+ * jtj is not NULL, the Gauss-Newton normal equations J^T J (8x8, row-major) and J^T e at p, so
+ * it can exploit the structure of its Jacobian. */
+typedef double (*home__normal_fn)(const void *user, const double *p, double *jtj, double *jte);
+int home__lm_solve(double *p, home__normal_fn fn, const void *user, int max_iters);
 int home__solve_spd8(double *a, double *b);
 
 /* refine.c */

@@ -9,17 +9,22 @@
  * finding 1). */
 #include "home_internal.h"
 #include <math.h>
+#include <string.h>
 
 typedef struct line_problem {
     const home__match *matches;
+    const int *index;        /* the inliers the fit runs over */
+    int n;
     double scale;            /* half diagonal, px: normalises r */
     double w_theta, w_r;     /* residual weights into Hough bins */
 } line_problem;
 
-static void line_residual(const void *user, int i, const double *g, double *e, double *jac)
+/* Residual e (3 components) of match m at g. With k (may be NULL), the Jacobian in the six
+ * numbers it is made of: with l the line in A, rows 0..2 of de/dg are
+ * (k0 l, k1 l, 0, 0), (k1 l, k2 l, 0, 0) and (k3 l, k4 l, k5 l0, k5 l1). */
+static void line_residual(const line_problem *lp, const home__match *m, const double *g,
+                          double *e, double *k)
 {
-    const line_problem *lp = (const line_problem *)user;
-    const home__match *m = &lp->matches[i];
     double l0 = m->cos_a, l1 = m->sin_a;
     double l2 = -(double)m->r_a / lp->scale;
     double a = g[0] * l0 + g[1] * l1 + g[2] * l2;
@@ -30,24 +35,70 @@ static void line_residual(const void *user, int i, const double *g, double *e, d
     e[0] = lp->w_theta * (a / n - m->cos_b);
     e[1] = lp->w_theta * (b / n - m->sin_b);
     e[2] = lp->w_r * (c / n + (double)m->r_b / lp->scale);
-    if (jac) {
-        double n3 = nn * n, l[3];
-        double da_a = b * b / n3, da_b = -a * b / n3, db_b = a * a / n3;
-        double dc_a = -c * a / n3, dc_b = -c * b / n3, dc_c = 1.0 / n;
-        int k;
-        l[0] = l0; l[1] = l1; l[2] = l2;
-        for (k = 0; k < 3; k++) {
-            jac[0 * 8 + k] = lp->w_theta * da_a * l[k];
-            jac[0 * 8 + 3 + k] = lp->w_theta * da_b * l[k];
-            jac[1 * 8 + k] = lp->w_theta * da_b * l[k];
-            jac[1 * 8 + 3 + k] = lp->w_theta * db_b * l[k];
-            jac[2 * 8 + k] = lp->w_r * dc_a * l[k];
-            jac[2 * 8 + 3 + k] = lp->w_r * dc_b * l[k];
-        }
-        jac[0 * 8 + 6] = jac[0 * 8 + 7] = jac[1 * 8 + 6] = jac[1 * 8 + 7] = 0.0;
-        jac[2 * 8 + 6] = lp->w_r * dc_c * l0;
-        jac[2 * 8 + 7] = lp->w_r * dc_c * l1;
+    if (k) {
+        double n3 = nn * n;
+        k[0] = lp->w_theta * b * b / n3;
+        k[1] = -lp->w_theta * a * b / n3;
+        k[2] = lp->w_theta * a * a / n3;
+        k[3] = -lp->w_r * c * a / n3;
+        k[4] = -lp->w_r * c * b / n3;
+        k[5] = lp->w_r / n;
     }
+}
+
+/* Cost, and J^T J, J^T e over the inliers. J^T J is made of blocks s * l l^T: six symmetric
+ * 3x3 sums (36 products per line instead of the 192 of the dense 3x8 Jacobian). */
+static double line_normal(const void *user, const double *g, double *jtj, double *jte)
+{
+    const line_problem *lp = (const line_problem *)user;
+    /* blocks: AA, AB, BB (3x3), AC, BC (3x2), CC (2x2) over l l^T's entries 00 01 02 11 12 22 */
+    double blk[6][6], ev[3][3], cost = 0.0;
+    int i, t, u;
+    if (jtj) { memset(blk, 0, sizeof blk); memset(ev, 0, sizeof ev); }
+    for (i = 0; i < lp->n; i++) {
+        const home__match *m = &lp->matches[lp->index[i]];
+        double e[3], k[6];
+        line_residual(lp, m, g, e, jtj ? k : NULL);
+        cost += e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        if (jtj) {
+            const double l[3] = {m->cos_a, m->sin_a, -(double)m->r_a / lp->scale};
+            const double ll[6] = {l[0] * l[0], l[0] * l[1], l[0] * l[2],
+                                  l[1] * l[1], l[1] * l[2], l[2] * l[2]};
+            const double s[6] = {k[0] * k[0] + k[1] * k[1] + k[3] * k[3],
+                                 k[0] * k[1] + k[1] * k[2] + k[3] * k[4],
+                                 k[1] * k[1] + k[2] * k[2] + k[4] * k[4],
+                                 k[3] * k[5], k[4] * k[5], k[5] * k[5]};
+            const double ea = k[0] * e[0] + k[1] * e[1] + k[3] * e[2];
+            const double eb = k[1] * e[0] + k[2] * e[1] + k[4] * e[2];
+            const double ec = k[5] * e[2];
+            for (t = 0; t < 6; t++)
+                for (u = 0; u < 6; u++) blk[t][u] += s[t] * ll[u];
+            for (t = 0; t < 3; t++) { ev[0][t] += ea * l[t]; ev[1][t] += eb * l[t]; ev[2][t] += ec * l[t]; }
+        }
+    }
+    if (jtj) {
+        static const int ll_index[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+        for (t = 0; t < 3; t++) {
+            for (u = 0; u < 3; u++) {
+                const int q = ll_index[t][u];
+                jtj[t * 8 + u] = blk[0][q];
+                jtj[t * 8 + 3 + u] = jtj[(3 + u) * 8 + t] = blk[1][q];
+                jtj[(3 + t) * 8 + 3 + u] = blk[2][q];
+            }
+            for (u = 0; u < 2; u++) {
+                const int q = ll_index[t][u];
+                jtj[t * 8 + 6 + u] = jtj[(6 + u) * 8 + t] = blk[3][q];
+                jtj[(3 + t) * 8 + 6 + u] = jtj[(6 + u) * 8 + 3 + t] = blk[4][q];
+            }
+            jte[t] = ev[0][t];
+            jte[3 + t] = ev[1][t];
+        }
+        for (t = 0; t < 2; t++)
+            for (u = 0; u < 2; u++) jtj[(6 + t) * 8 + 6 + u] = blk[5][ll_index[t][u]];
+        jte[6] = ev[2][0];
+        jte[7] = ev[2][1];
+    }
+    return cost;
 }
 
 static int select_inliers(const line_problem *lp, int n, const double *g, double threshold,
@@ -56,7 +107,7 @@ static int select_inliers(const line_problem *lp, int n, const double *g, double
     int i, count = 0;
     double t2 = threshold * threshold, e[3];
     for (i = 0; i < n; i++) {
-        line_residual(lp, i, g, e, NULL);
+        line_residual(lp, &lp->matches[i], g, e, NULL);
         if (e[0] * e[0] + e[1] * e[1] + e[2] * e[2] < t2) index[count++] = i;
     }
     return count;
@@ -101,6 +152,8 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     int n_in = 0, k, level;
 
     lp.matches = ctx->matches;
+    lp.index = ctx->inlier_index;
+    lp.n = 0;
     lp.scale = sqrt(cx * cx + cy * cy);
     lp.w_theta = cfg->theta_bins / HOME__PI;
     lp.w_r = lp.scale / (cfg->r_step * ctx->hough_scale); /* Hough bins of the transform */
@@ -114,7 +167,8 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
         if (n_in < 6) break;               /* too few lines left to constrain 8 parameters */
         /* coarse levels only move the estimate into the next, narrower gate: a few iterations
          * do; the final level converges fully */
-        if (!home__lm_solve(g, n_in, ctx->inlier_index, line_residual, &lp,
+        lp.n = n_in;
+        if (!home__lm_solve(g, line_normal, &lp,
                             t <= cfg->threshold_final ? HOME_LM_MAX_ITERS : HOME_LM_COARSE_ITERS))
             break;
         if (t <= cfg->threshold_final) break;

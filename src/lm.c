@@ -1,6 +1,6 @@
-/* A small fixed-size Levenberg-Marquardt solver for 8 parameters with 3-component residuals:
- * normal equations accumulated in double and solved in place by Cholesky. Work is bounded by
- * max_iters outer iterations of at most LM_MAX_TRIES damping attempts each. */
+/* A small fixed-size Levenberg-Marquardt solver for 8 parameters: the problem builds its normal
+ * equations (in double), solved in place by Cholesky. Work is bounded by max_iters outer
+ * iterations of at most LM_MAX_TRIES damping attempts each. */
 #include "home_internal.h"
 #include <math.h>
 #include <string.h>
@@ -38,46 +38,15 @@ int home__solve_spd8(double *a, double *b)
     return 1;
 }
 
-static double total_cost(const double *p, int n, const int *index, home__residual_fn fn,
-                         const void *user)
+int home__lm_solve(double *p, home__normal_fn fn, const void *user, int max_iters)
 {
-    double cost = 0.0, e[3];
-    int i;
-    for (i = 0; i < n; i++) {
-        fn(user, index[i], p, e, NULL);
-        cost += e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-    }
-    return cost;
-}
-
-int home__lm_solve(double *p, int n, const int *index, home__residual_fn fn, const void *user,
-                   int max_iters)
-{
-    double lambda = 1e-3, cost = total_cost(p, n, index, fn, user);
+    double lambda = 1e-3, cost = fn(user, p, NULL, NULL);
     int it;
     if (!isfinite(cost)) return 0;
     for (it = 0; it < max_iters; it++) {
-        double jtj[NP * NP], jte[NP], e[3], jac[3 * NP];
-        int i, r, a, tries, improved = 0;
-        memset(jtj, 0, sizeof jtj);
-        memset(jte, 0, sizeof jte);
-        for (i = 0; i < n; i++) {
-            fn(user, index[i], p, e, jac);
-            /* the full square, unrolled; Jacobian rows are often partly zero */
-            for (r = 0; r < 3; r++) {
-                const double *row = jac + r * NP;
-                for (a = 0; a < NP; a++) {
-                    const double ra = row[a];
-                    double *dst = jtj + a * NP;
-                    if (ra == 0.0) continue;
-                    jte[a] += ra * e[r];
-                    dst[0] += ra * row[0]; dst[1] += ra * row[1];
-                    dst[2] += ra * row[2]; dst[3] += ra * row[3];
-                    dst[4] += ra * row[4]; dst[5] += ra * row[5];
-                    dst[6] += ra * row[6]; dst[7] += ra * row[7];
-                }
-            }
-        }
+        double jtj[NP * NP], jte[NP];
+        int a, tries, improved = 0;
+        fn(user, p, jtj, jte);
         for (tries = 0; tries < LM_MAX_TRIES; tries++) {
             double m[NP * NP], step[NP], trial[NP], new_cost;
             memcpy(m, jtj, sizeof m);
@@ -87,7 +56,7 @@ int home__lm_solve(double *p, int n, const int *index, home__residual_fn fn, con
             }
             if (home__solve_spd8(m, step)) {
                 for (a = 0; a < NP; a++) trial[a] = p[a] + step[a];
-                new_cost = total_cost(trial, n, index, fn, user);
+                new_cost = fn(user, trial, NULL, NULL);
                 if (isfinite(new_cost) && new_cost < cost) {
                     double gain = cost - new_cost;
                     memcpy(p, trial, sizeof trial);
