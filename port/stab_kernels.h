@@ -6,15 +6,18 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Fixed point of warp coordinates: Q16 pixels; bilinear weights use the top 8 fraction bits. */
+/* Fixed point of warp coordinates: Q16 pixels. The bilinear weight of a coordinate is its
+ * offset f (Q16, 0..65536) from the pair's first pixel rounded to 1/128: 0..128, 7 bits that
+ * keep every intermediate of the blend in int16. */
 #define HOME__WARP_FRAC_BITS 16
+#define HOME__WARP_WEIGHT(f) ((uint32_t)(((f) + 256) >> 9))
 
 /* One output row of a bilinear warp. Output pixel i samples the source at
  * (x0 + i*dx, y0 + i*dy) (Q16 source pixels), clamped to [0, w-1] x [0, h-1] (edge replicate).
  * Source pixel (x, y) is the byte src[y*stride + x*step]; output pixel i goes to dst[i*dst_step].
- * Requires w, h >= 2 and every coordinate of the row within int32. With the fractions rounded to
- * 1/256 (fx, fy in 0..256), the result is
- * ((p00 (256-fx) + p01 fx) (256-fy) + (p10 (256-fx) + p11 fx) fy + 2^15) >> 16, and every
+ * Requires w, h >= 2 and every coordinate of the row within int32. With the weights
+ * fx, fy = HOME__WARP_WEIGHT of the (clamped) coordinates' fractions, the result is
+ * ((p00 (128-fx) + p01 fx) (128-fy) + (p10 (128-fx) + p11 fx) fy + 2^13) >> 14, and every
  * implementation must give it bit for bit. */
 void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                       int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n);

@@ -1,50 +1,80 @@
-/* NEON warp row kernel: four output pixels per step, scalar gathers of the 2x2 source pixels,
- * vector weights and blends in 32-bit lanes giving the scalar reference's bytes. Rows that need
- * clamping, or are not planar, use the reference. */
+/* NEON warp row kernel: the SSE2 kernel's scheme (port/stab_sse.c) - eight output pixels per
+ * step, each pixel's horizontal pairs one 16-bit load from rows shared by the eight, weights from
+ * 16-bit fractions - with widening multiplies and rounding narrowing shifts that give the
+ * reference's bytes exactly. Rows that need clamping, or are not planar, use the reference. */
 #include "stab_kernels.h"
+#include <string.h>
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #include <arm_neon.h>
+
+static uint16_t load_pair(const uint8_t *p)
+{
+    uint16_t v;
+    memcpy(&v, p, sizeof v);   /* unaligned */
+    return v;
+}
+
+/* the fractions (q + k dq) & 0xffff, k = 0..7 */
+static uint16x8_t fractions(int32_t q, int32_t dq)
+{
+    uint16_t f[8];
+    int k;
+    for (k = 0; k < 8; k++) f[k] = (uint16_t)(q + k * dq);
+    return vld1q_u16(f);
+}
 
 static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                           int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
-    const uint32x4_t frac = vdupq_n_u32(0xffff), half = vdupq_n_u32(128), one = vdupq_n_u32(256);
-    const uint32x4_t round = vdupq_n_u32(32768);
-    const int32x4_t step_x = vdupq_n_s32(4 * dx), step_y = vdupq_n_s32(4 * dy);
-    const int32_t lanes[4] = {0, 1, 2, 3};
-    int32x4_t vx, vy;
+    const uint8x8_t c128 = vdup_n_u8(128);
+    const uint16x8_t c128w = vdupq_n_u16(128);
+    const uint16x8_t step_x = vdupq_n_u16((uint16_t)(8 * dx)), step_y = vdupq_n_u16((uint16_t)(8 * dy));
+    uint16x8_t frac_x, frac_y;
+    int32_t x = x0, y = y0;
     int i = 0;
     if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
-    vx = vmlaq_n_s32(vdupq_n_s32(x0), vld1q_s32(lanes), dx);
-    vy = vmlaq_n_s32(vdupq_n_s32(y0), vld1q_s32(lanes), dy);
-    for (; i + 4 <= n; i += 4) {
-        int32_t xi[4], yi[4];
-        uint32_t a[4], b[4], c[4], d[4];
-        uint32x4_t fx, fy, wx, top, bot, res;
-        uint16_t out[4];
-        int k;
-        vst1q_s32(xi, vshrq_n_s32(vx, HOME__WARP_FRAC_BITS));
-        vst1q_s32(yi, vshrq_n_s32(vy, HOME__WARP_FRAC_BITS));
-        for (k = 0; k < 4; k++) {
-            const uint8_t *p = src + (ptrdiff_t)yi[k] * stride + xi[k];
-            a[k] = p[0]; b[k] = p[1]; c[k] = p[stride]; d[k] = p[stride + 1];
+    frac_x = fractions(x0, dx);
+    frac_y = fractions(y0, dy);
+    for (; i + 8 <= n; i += 8, x += 8 * dx, y += 8 * dy) {
+        uint16x8_t top = vdupq_n_u16(0), bot = vdupq_n_u16(0), t, b, fy, gy;
+        uint8x8_t fx, gx;
+        uint32x4_t r0, r1;
+        const uint8_t *row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+        uint32_t xs = (uint32_t)x;   /* >= 0 in an inside row */
+        if ((y >> HOME__WARP_FRAC_BITS) != ((y + 7 * dy) >> HOME__WARP_FRAC_BITS)) {
+            home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, 8);   /* rows differ */
+            frac_x = vaddq_u16(frac_x, step_x);
+            frac_y = vaddq_u16(frac_y, step_y);
+            continue;
         }
-        fx = vshrq_n_u32(vaddq_u32(vandq_u32(vreinterpretq_u32_s32(vx), frac), half), 8);
-        fy = vshrq_n_u32(vaddq_u32(vandq_u32(vreinterpretq_u32_s32(vy), frac), half), 8);
-        wx = vsubq_u32(one, fx);
-        top = vmlaq_u32(vmulq_u32(vld1q_u32(a), wx), vld1q_u32(b), fx);
-        bot = vmlaq_u32(vmulq_u32(vld1q_u32(c), wx), vld1q_u32(d), fx);
-        res = vaddq_u32(vmlaq_u32(vmulq_u32(top, vsubq_u32(one, fy)), bot, fy), round);
-        vst1_u16(out, vmovn_u32(vshrq_n_u32(res, 16)));
-        for (k = 0; k < 4; k++) dst[i + k] = (uint8_t)out[k];
-        vx = vaddq_s32(vx, step_x);
-        vy = vaddq_s32(vy, step_y);
+#define NEON_LANE(k)                                                                       \
+    {                                                                                      \
+        const uint8_t *p = row + (xs >> HOME__WARP_FRAC_BITS);                             \
+        top = vsetq_lane_u16(load_pair(p), top, k);                                        \
+        bot = vsetq_lane_u16(load_pair(p + stride), bot, k);                               \
+        xs += (uint32_t)dx;                                                                \
+    }
+        NEON_LANE(0) NEON_LANE(1) NEON_LANE(2) NEON_LANE(3) NEON_LANE(4) NEON_LANE(5) NEON_LANE(6) NEON_LANE(7)
+#undef NEON_LANE
+        /* HOME__WARP_WEIGHT: vrshr computes (f + 256) >> 9 without overflowing 16 bits */
+        fx = vmovn_u16(vrshrq_n_u16(frac_x, 9));
+        gx = vsub_u8(c128, fx);
+        fy = vrshrq_n_u16(frac_y, 9);
+        gy = vsubq_u16(c128w, fy);
+        t = vmlal_u8(vmull_u8(vmovn_u16(top), gx), vshrn_n_u16(top, 8), fx);
+        b = vmlal_u8(vmull_u8(vmovn_u16(bot), gx), vshrn_n_u16(bot, 8), fx);
+        r0 = vmlal_u16(vmull_u16(vget_low_u16(t), vget_low_u16(gy)), vget_low_u16(b), vget_low_u16(fy));
+        r1 = vmlal_u16(vmull_u16(vget_high_u16(t), vget_high_u16(gy)), vget_high_u16(b), vget_high_u16(fy));
+        /* vrshrn: (r + 2^13) >> 14 */
+        vst1_u8(dst + i, vmovn_u16(vcombine_u16(vrshrn_n_u32(r0, 14), vrshrn_n_u32(r1, 14))));
+        frac_x = vaddq_u16(frac_x, step_x);
+        frac_y = vaddq_u16(frac_y, step_y);
     }
     if (i < n)   /* the rest of an inside row: the reference's fast path, same bytes */
-        home__warp_row_c(src, stride, 1, w, h, x0 + i * dx, y0 + i * dy, dx, dy, dst + i, 1, n - i);
+        home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, n - i);
 }
 
 const home__stab_kernels home__stab_kernels_neon = {"neon", warp_row_neon};

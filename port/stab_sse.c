@@ -1,61 +1,88 @@
-/* SSE2 warp row kernel: four output pixels per step; the 2x2 source pixels are gathered with
- * scalar loads (SSE2 has no gather), the weights and blends are vector integer arithmetic giving
- * the scalar reference's bytes. Rows that need clamping, or are not planar, use the reference. */
+/* SSE2 warp row kernel: eight output pixels per step. A pixel's horizontal pairs (p00, p01) and
+ * (p10, p11) are one 16-bit load each (pinsrw), so it costs two loads instead of four, and the
+ * row address is shared while the eight pixels read the same source rows (a near-horizontal
+ * warp: almost always). Weights come from the coordinates' 16-bit fractions, which wrap like
+ * the low halves of the Q16 sums; the blends are pmullw and pmaddwd on the reference's 7-bit
+ * weights, its bytes exactly. Rows that need clamping, or are not planar, use the reference. */
 #include "stab_kernels.h"
+#include <string.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 
-/* lane-wise a * b for products below 2^32 */
-static __m128i mul_u32(__m128i a, __m128i b)
+static int load_pair(const uint8_t *p)
 {
-    __m128i even = _mm_mul_epu32(a, b);
-    __m128i odd = _mm_mul_epu32(_mm_srli_epi64(a, 32), _mm_srli_epi64(b, 32));
-    return _mm_unpacklo_epi32(_mm_shuffle_epi32(even, _MM_SHUFFLE(0, 0, 2, 0)),
-                              _mm_shuffle_epi32(odd, _MM_SHUFFLE(0, 0, 2, 0)));
+    uint16_t v;
+    memcpy(&v, p, sizeof v);   /* unaligned */
+    return v;
 }
+
+/* low 16 bits of q as the bit pattern of a short (defined for every q, unlike a cast) */
+static short low16(int32_t q) { return (short)((q & 0x7fff) - (q & 0x8000)); }
+
+/* the fractions (q + k dq) & 0xffff, k = 0..7, in 16-bit lanes */
+static __m128i fractions(int32_t q, int32_t dq)
+{
+    return _mm_setr_epi16(low16(q), low16(q + dq), low16(q + 2 * dq), low16(q + 3 * dq),
+                          low16(q + 4 * dq), low16(q + 5 * dq), low16(q + 6 * dq), low16(q + 7 * dq));
+}
+
+/* HOME__WARP_WEIGHT of 16-bit fractions: (f + 256) >> 9 = ((f >> 8) + 1) >> 1, pavgw with 0 */
+static __m128i weight(__m128i frac) { return _mm_avg_epu16(_mm_srli_epi16(frac, 8), _mm_setzero_si128()); }
 
 static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                          int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
-    const __m128i frac = _mm_set1_epi32(0xffff), half = _mm_set1_epi32(128), one = _mm_set1_epi32(256);
-    const __m128i round = _mm_set1_epi32(32768), step_x = _mm_set1_epi32(4 * dx), step_y = _mm_set1_epi32(4 * dy);
-    __m128i vx, vy;
+    const __m128i zero = _mm_setzero_si128(), round = _mm_set1_epi32(8192);
+    const __m128i c128 = _mm_set1_epi16(128), low = _mm_set1_epi16(0xff);
+    const __m128i step_x = _mm_set1_epi16(low16(8 * dx)), step_y = _mm_set1_epi16(low16(8 * dy));
+    __m128i frac_x, frac_y;
+    int32_t x = x0, y = y0;
     int i = 0;
     if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
-    vx = _mm_setr_epi32(x0, x0 + dx, x0 + 2 * dx, x0 + 3 * dx);
-    vy = _mm_setr_epi32(y0, y0 + dy, y0 + 2 * dy, y0 + 3 * dy);
-    for (; i + 4 <= n; i += 4) {
-        int32_t xi[4], yi[4], p01[4], p23[4];
-        __m128i fx, fy, wx, top, bot, res;
-        int k;
-        _mm_storeu_si128((__m128i *)(void *)xi, _mm_srai_epi32(vx, HOME__WARP_FRAC_BITS));
-        _mm_storeu_si128((__m128i *)(void *)yi, _mm_srai_epi32(vy, HOME__WARP_FRAC_BITS));
-        for (k = 0; k < 4; k++) {
-            const uint8_t *p = src + (ptrdiff_t)yi[k] * stride + xi[k];
-            p01[k] = p[0] | p[1] << 16;             /* int16 pairs for madd */
-            p23[k] = p[stride] | p[stride + 1] << 16;
+    frac_x = fractions(x0, dx);
+    frac_y = fractions(y0, dy);
+    for (; i + 8 <= n; i += 8, x += 8 * dx, y += 8 * dy) {
+        __m128i top = zero, bot = zero, fx, fy, gx, gy, t, b, r0, r1;
+        const uint8_t *row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+        uint32_t xs = (uint32_t)x;   /* >= 0 in an inside row; unsigned: no sign extensions */
+        /* affine: the eight pixels share their rows when the first and the last do; else (a
+         * row of the warp crossing a source row: rare) the reference does them */
+        if ((y >> HOME__WARP_FRAC_BITS) != ((y + 7 * dy) >> HOME__WARP_FRAC_BITS)) {
+            home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, 8);
+            goto next;
         }
-        fx = _mm_srli_epi32(_mm_add_epi32(_mm_and_si128(vx, frac), half), 8);
-        fy = _mm_srli_epi32(_mm_add_epi32(_mm_and_si128(vy, frac), half), 8);
-        wx = _mm_or_si128(_mm_sub_epi32(one, fx), _mm_slli_epi32(fx, 16));
-        top = _mm_madd_epi16(_mm_loadu_si128((const __m128i *)(const void *)p01), wx);
-        bot = _mm_madd_epi16(_mm_loadu_si128((const __m128i *)(const void *)p23), wx);
-        res = _mm_add_epi32(_mm_add_epi32(mul_u32(top, _mm_sub_epi32(one, fy)), mul_u32(bot, fy)), round);
-        res = _mm_srli_epi32(res, 16);
-        res = _mm_packs_epi32(res, res);
-        res = _mm_packus_epi16(res, res);
-        {
-            int32_t four = _mm_cvtsi128_si32(res);
-            for (k = 0; k < 4; k++) dst[i + k] = (uint8_t)(four >> (8 * k));
-        }
-        vx = _mm_add_epi32(vx, step_x);
-        vy = _mm_add_epi32(vy, step_y);
+#define SSE_LANE(k)                                                                        \
+    {                                                                                      \
+        const uint8_t *p = row + (xs >> HOME__WARP_FRAC_BITS);                             \
+        top = _mm_insert_epi16(top, load_pair(p), k);                                      \
+        bot = _mm_insert_epi16(bot, load_pair(p + stride), k);                             \
+        xs += (uint32_t)dx;                                                                \
+    }
+        SSE_LANE(0) SSE_LANE(1) SSE_LANE(2) SSE_LANE(3) SSE_LANE(4) SSE_LANE(5) SSE_LANE(6) SSE_LANE(7)
+#undef SSE_LANE
+        fx = weight(frac_x);
+        gx = _mm_sub_epi16(c128, fx);
+        fy = weight(frac_y);
+        gy = _mm_sub_epi16(c128, fy);
+        /* horizontal: p0 (128 - fx) + p1 fx <= 32640, exact in 16 bits */
+        t = _mm_add_epi16(_mm_mullo_epi16(_mm_and_si128(top, low), gx), _mm_mullo_epi16(_mm_srli_epi16(top, 8), fx));
+        b = _mm_add_epi16(_mm_mullo_epi16(_mm_and_si128(bot, low), gx), _mm_mullo_epi16(_mm_srli_epi16(bot, 8), fx));
+        /* vertical: top (128 - fy) + bot fy in 32 bits */
+        r0 = _mm_madd_epi16(_mm_unpacklo_epi16(t, b), _mm_unpacklo_epi16(gy, fy));
+        r1 = _mm_madd_epi16(_mm_unpackhi_epi16(t, b), _mm_unpackhi_epi16(gy, fy));
+        r0 = _mm_srli_epi32(_mm_add_epi32(r0, round), 14);
+        r1 = _mm_srli_epi32(_mm_add_epi32(r1, round), 14);
+        r0 = _mm_packs_epi32(r0, r1);
+        _mm_storel_epi64((__m128i *)(void *)(dst + i), _mm_packus_epi16(r0, r0));
+    next:
+        frac_x = _mm_add_epi16(frac_x, step_x);
+        frac_y = _mm_add_epi16(frac_y, step_y);
     }
     if (i < n)   /* the rest of an inside row: the reference's fast path, same bytes */
-        home__warp_row_c(src, stride, 1, w, h, x0 + i * dx, y0 + i * dy, dx, dy, dst + i, 1, n - i);
+        home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, n - i);
 }
 
 const home__stab_kernels home__stab_kernels_sse = {"sse", warp_row_sse};

@@ -5,19 +5,26 @@
 #include "stab_kernels.h"
 #include <math.h>
 
+/* The reference's arithmetic on one 2x2 neighbourhood p (p[0], p[step], p[stride],
+ * p[stride + step]) with 7-bit weights: every intermediate fits int16 and the vertical blend
+ * int32, which SSE2's pmaddwd and NEON's widening multiplies compute exactly. */
+static uint8_t blend(const uint8_t *p, ptrdiff_t stride, int step, uint32_t fx, uint32_t fy)
+{
+    const uint32_t top = p[0] * (128 - fx) + p[step] * fx;
+    const uint32_t bot = p[stride] * (128 - fx) + p[stride + step] * fx;
+    return (uint8_t)((top * (128 - fy) + bot * fy + 8192u) >> 14);
+}
+
 /* Inner loop for a row whose every sample lies inside [0, w-1) x [0, h-1): no clamping. Gives
  * the same bytes as the clamped loop there (xi = x >> 16 <= w - 2 already). */
 static void warp_row_inside(const uint8_t *src, ptrdiff_t stride, int step, int32_t x, int32_t y,
                             int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
     int i;
-    for (i = 0; i < n; i++, x += dx, y += dy) {
-        const uint8_t *p = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride + (ptrdiff_t)(x >> HOME__WARP_FRAC_BITS) * step;
-        const uint32_t fx = (uint32_t)(((x & 0xffff) + 128) >> 8), fy = (uint32_t)(((y & 0xffff) + 128) >> 8);
-        const uint32_t top = p[0] * (256 - fx) + p[step] * fx;
-        const uint32_t bot = p[stride] * (256 - fx) + p[stride + step] * fx;
-        dst[(ptrdiff_t)i * dst_step] = (uint8_t)((top * (256 - fy) + bot * fy + 32768u) >> 16);
-    }
+    for (i = 0; i < n; i++, x += dx, y += dy)
+        dst[(ptrdiff_t)i * dst_step] =
+            blend(src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride + (ptrdiff_t)(x >> HOME__WARP_FRAC_BITS) * step,
+                  stride, step, HOME__WARP_WEIGHT(x & 0xffff), HOME__WARP_WEIGHT(y & 0xffff));
 }
 
 int home__warp_row_inside(int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, int n)
@@ -45,21 +52,16 @@ void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int
         return;
     }
     for (i = 0; i < n; i++, x += dx, y += dy) {
-        /* clamp into the plane; at the last column/row use the pair (w-2, w-1) with weight 256 */
+        /* clamp into the plane; at the last column/row use the pair (w-2, w-1) with weight 128 */
         int32_t xc = x < 0 ? 0 : x > x_max ? x_max : x;
         int32_t yc = y < 0 ? 0 : y > y_max ? y_max : y;
         int32_t xi = xc >> HOME__WARP_FRAC_BITS, yi = yc >> HOME__WARP_FRAC_BITS;
-        int32_t fx, fy;
-        const uint8_t *p;
-        uint32_t top, bot;
         if (xi > w - 2) xi = w - 2;
         if (yi > h - 2) yi = h - 2;
-        fx = (xc - (xi << HOME__WARP_FRAC_BITS) + 128) >> 8;   /* 0..256, rounded */
-        fy = (yc - (yi << HOME__WARP_FRAC_BITS) + 128) >> 8;
-        p = src + (ptrdiff_t)yi * stride + (ptrdiff_t)xi * step;
-        top = (uint32_t)(p[0] * (256 - fx) + p[step] * fx);
-        bot = (uint32_t)(p[stride] * (256 - fx) + p[stride + step] * fx);
-        dst[(ptrdiff_t)i * dst_step] = (uint8_t)((top * (uint32_t)(256 - fy) + bot * (uint32_t)fy + 32768u) >> 16);
+        dst[(ptrdiff_t)i * dst_step] =
+            blend(src + (ptrdiff_t)yi * stride + (ptrdiff_t)xi * step, stride, step,
+                  HOME__WARP_WEIGHT(xc - (xi << HOME__WARP_FRAC_BITS)),
+                  HOME__WARP_WEIGHT(yc - (yi << HOME__WARP_FRAC_BITS)));
     }
 }
 
