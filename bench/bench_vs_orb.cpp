@@ -32,22 +32,17 @@ static double median(std::vector<double> v) {
 
 struct HomeTimes { double frame, stage[HOME_STAGE_COUNT], pair_total; double err; size_t arena; };
 
-// preset 0: defaults with refinement; 1: defaults without; 2: video preset for small cores
-// (Hough of the 2x2-downscaled frame, theta-window motion prior 27 bins, first threshold 16,
-// refinement on)
+// preset 0: defaults with refinement; 1: defaults without; 2: home_video_config (Hough of a
+// ~160 px wide box-downscaled frame, 240 theta bins, theta window, refinement at full size)
 static const char *preset_name[] = {"default", "no-refine", "video"};
 
 static bool time_home(int simd, int preset, int w, int h, const std::vector<uint8_t> &a,
                       const std::vector<uint8_t> &b, const double *truth, int runs, HomeTimes &out) {
     home_config cfg;
-    home_default_config(&cfg, w, h);
+    if (preset == 2) home_video_config(&cfg, w, h);
+    else home_default_config(&cfg, w, h);
     cfg.simd = simd;
     if (preset == 1) cfg.refine_levels = 0;
-    if (preset == 2) {
-        cfg.hough_downscale = 2;
-        cfg.match_theta_window = 27;
-        cfg.threshold_start = 16;
-    }
     cfg.clock = now_ms;
     if (home_validate_config(&cfg) != HOME_OK) return false;
     out.arena = home_arena_size(&cfg);
@@ -110,7 +105,8 @@ static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::v
 }
 
 // Only the per-frame work, n times, for instruction counting under callgrind:
-//   home-bench --frames orb|home N [downscale [theta_window [threshold_start [theta_bins [keypoints]]]]]
+//   home-bench --frames orb|video|home N [downscale [theta_window [threshold_start [theta_bins [keypoints]]]]]
+// (video: home_video_config; home: the defaults with the given overrides)
 static int count_frames(const char *method, int n, int downscale, int window, float t0, int theta_bins,
                         int keypoints) {
     const int w = 640, h = 360;
@@ -127,7 +123,13 @@ static int count_frames(const char *method, int n, int downscale, int window, fl
         return 0;
     }
     home_config cfg;
-    home_default_config(&cfg, w, h);
+    if (std::string(method) == "video") {
+        home_video_config(&cfg, w, h);
+        downscale = cfg.hough_downscale;
+        window = cfg.match_theta_window;
+    } else {
+        home_default_config(&cfg, w, h);
+    }
     cfg.hough_downscale = downscale;
     cfg.match_theta_window = window;
     if (t0 > 0) cfg.threshold_start = t0;

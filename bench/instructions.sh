@@ -15,15 +15,16 @@ count() { # simd, method, n, downscale
 }
 per_frame() { local one three; one=$(count "$@" 1 "${4:-1}"); three=$(count "$1" "$2" 3 "${4:-1}"); echo $(( (three - one) / 2 )); }
 orb=$(per_frame none orb x 1)
-printf '\n%-8s %-10s %14s %10s %14s\n' method hough frame_Ir "ORB/HOME" "A72 est. ms"
+printf '\n%-8s %-10s %14s %10s %14s\n' method preset frame_Ir "ORB/HOME" "A72 est. ms"
 printf '%-8s %-10s %14d %10s %14s\n' orb - "$orb" 1.00 -
 for simd in none sse avx2; do
-  for ds in 1 2; do
-    n=$(HOME_SIMD=$simd valgrind --tool=callgrind --callgrind-out-file=/dev/null "$bench" --frames home 1 $ds 2>&1 >/dev/null | awk '/Collected/ {print $NF}')
-    m=$(HOME_SIMD=$simd valgrind --tool=callgrind --callgrind-out-file=/dev/null "$bench" --frames home 3 $ds 2>&1 >/dev/null | awk '/Collected/ {print $NF}')
+  for preset in default video; do
+    method=$([ $preset = default ] && echo home || echo video)
+    n=$(HOME_SIMD=$simd valgrind --tool=callgrind --callgrind-out-file=/dev/null "$bench" --frames $method 1 2>&1 >/dev/null | awk '/Collected/ {print $NF}')
+    m=$(HOME_SIMD=$simd valgrind --tool=callgrind --callgrind-out-file=/dev/null "$bench" --frames $method 3 2>&1 >/dev/null | awk '/Collected/ {print $NF}')
     [ -n "$n" ] && [ -n "$m" ] || continue
     f=$(( (m - n) / 2 ))
-    printf '%-8s %-10s %14d %10.2f %14.1f\n' "$simd" "$([ $ds = 1 ] && echo full || echo half)" "$f" \
+    printf '%-8s %-10s %14d %10.2f %14.1f\n' "$simd" "$preset" "$f" \
       "$(echo "$orb / $f" | bc -l)" "$(echo "$f / 1.5 / 1500000" | bc -l)"
   done
 done

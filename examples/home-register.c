@@ -27,13 +27,16 @@ static void usage(FILE *f)
         "Registers binary PGM image A (P5, 8-bit) to B of the same size (%d..%d px a side) and\n"
         "prints one JSON line: ok, H (A -> B pixels, row-major, h22 = 1), keypoints, matches,\n"
         "inliers, ms. Exit 0 after a registration (\"ok\":false when it failed), 2 on bad input.\n"
-        "options:\n"
+        "options (applied in this order after the defaults):\n"
+        "  --video              start from the video-frame defaults (home_video_config): Hough\n"
+        "                       on a frame ~160 px wide, 240 theta bins, 500 keypoints, theta\n"
+        "                       window 14, first threshold 8; the refinement at full size\n"
         "  --keypoints N        keypoints kept per sign of J (default 1000, max %d)\n"
         "  --theta-bins N       Hough theta bins over [0, pi) (default 480)\n"
         "  --r-step PX          px per Hough r bin (default 1.0)\n"
         "  --sigma BINS         Gaussian smoothing of the Hough image (default 1.3)\n"
-        "  --hough-downscale N  1: Hough transform of the full image (default); 2: of a 2x2-box\n"
-        "                       downscaled copy (4x less Hough work, for video on small cores)\n"
+        "  --hough-downscale N  1: Hough transform of the full image (default); 2 or 4: of a\n"
+        "                       2x2- or 4x4-box downscaled copy (4x or 16x less Hough work)\n"
         "  --theta-window N     motion prior: match only keypoints within N theta bins of each\n"
         "                       other (0 = off, the default; ~27 bins = 10 degrees for video)\n"
         "  --ratio R            Lowe ratio test (default 0.9)\n"
@@ -43,7 +46,8 @@ static void usage(FILE *f)
         "  --no-refine          keep HOME's homography (no photometric refinement)\n"
         "  --refine-levels N    refinement pyramid levels (default 3)\n"
         "  --refine-iterations N  Gauss-Newton iteration cap per level (default 10)\n"
-        "  --refine-trust PX    largest corner motion the refinement may make (default 6)\n"
+        "  --refine-trust PX    largest corner motion the refinement may make, in Hough-image\n"
+        "                       px (default 6)\n"
         "  --repeat N           register N times; ms are medians, plus \"frame\": B against A's\n"
         "                       cached features (the video case)\n"
         "  --save-hough F.pgm   write A's quantised Hough image (rows theta, columns r) with\n"
@@ -130,7 +134,7 @@ int main(int argc, char **argv)
 {
     const char *paths[2] = {NULL, NULL}, *hough_path = NULL;
     home_config cfg;
-    int n_paths = 0, i, repeat = 1, status, s;
+    int n_paths = 0, i, repeat = 1, status, s, video = 0;
     int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_downscale = -1,
         opt_window = -1;
     float opt_rtrust = -1;
@@ -152,6 +156,7 @@ int main(int argc, char **argv)
         int bad = 0;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
         if (!strcmp(a, "--no-refine")) { opt_rlevels = 0; continue; }
+        if (!strcmp(a, "--video")) { video = 1; continue; }
         if (!strncmp(a, "--", 2) && !v) { fprintf(stderr, "home-register: %s needs a value\n", a); return 2; }
         if (!strcmp(a, "--keypoints")) bad = parse_int(v, &opt_kp), i++;
         else if (!strcmp(a, "--theta-bins")) bad = parse_int(v, &opt_theta), i++;
@@ -183,7 +188,7 @@ int main(int argc, char **argv)
         free(buf_a); free(buf_b);
         return 2;
     }
-    if ((status = home_default_config(&cfg, wa, ha)) != HOME_OK) {
+    if ((status = (video ? home_video_config : home_default_config)(&cfg, wa, ha)) != HOME_OK) {
         fprintf(stderr, "home-register: %dx%d: %s\n", wa, ha, home_strerror(status));
         free(buf_a); free(buf_b);
         return 2;

@@ -57,6 +57,21 @@ int home_default_config(home_config *cfg, int width, int height)
     return HOME_OK;
 }
 
+int home_video_config(home_config *cfg, int width, int height)
+{
+    int status = home_default_config(cfg, width, height);
+    if (status != HOME_OK) return status;
+    /* the largest box that leaves the Hough image at least 160 px wide */
+    cfg->hough_downscale = width >= 640 && height >= 4 * HOME_MIN_SIDE ? 4
+                         : width >= 320 && height >= 2 * HOME_MIN_SIDE ? 2 : 1;
+    cfg->theta_bins = 240;        /* ~1 px at the rim of a 160 px Hough image */
+    cfg->wrap_band = 14;
+    cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 500 ? HOME_MAX_KEYPOINTS_PER_SIGN : 500;
+    cfg->match_theta_window = 14;
+    cfg->threshold_start = 8.0f;
+    return HOME_OK;
+}
+
 static int finite_in(float v, float lo, float hi)
 {
     return isfinite(v) && v >= lo && v <= hi;

@@ -94,6 +94,50 @@ void test_downscaled_hough(void)
     cfg.hough_downscale = 4; cfg.width = 4 * HOME_MIN_SIDE - 1;
     CHECK_EQ_INT(home_validate_config(&cfg), HOME_E_CONFIG);
 }
+/* The video preset: Hough on a ~160 px frame, registering frame pairs of video-sized motion
+ * (corners moved by up to 12 px) against cached features, sub-pixel after the refinement. */
+void test_video_config(void)
+{
+    home_config cfg;
+    home_context *ctx;
+    double worst = 0.0;
+    int k;
+    CHECK_EQ_INT(home_video_config(&cfg, IMG_W, IMG_H), HOME_OK);
+    CHECK_EQ_INT(home_validate_config(&cfg), HOME_OK);
+    CHECK_EQ_INT(cfg.hough_downscale, 4);
+    CHECK(home_arena_size(&cfg) < (size_t)1 << 20);
+    CHECK_EQ_INT(home_video_config(&cfg, 320, 180), HOME_OK);
+    CHECK_EQ_INT(cfg.hough_downscale, 2);
+    CHECK_EQ_INT(home_validate_config(&cfg), HOME_OK);
+    CHECK_EQ_INT(home_video_config(&cfg, 160, 120), HOME_OK);
+    CHECK_EQ_INT(cfg.hough_downscale, 1);
+    CHECK_EQ_INT(home_validate_config(&cfg), HOME_OK);
+    CHECK_EQ_INT(home_video_config(NULL, IMG_W, IMG_H), HOME_E_NULL);
+    CHECK_EQ_INT(home_video_config(&cfg, 8, IMG_H), HOME_E_SIZE);
+    home_video_config(&cfg, IMG_W, IMG_H);
+    ctx = test_context(IMG_W, IMG_H, &cfg);
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 4; k++) {
+        const int kind = k & 1 ? SYNTH_WEAK_TEXTURE : SYNTH_STRUCTURED;
+        uint64_t seed = 4100 + (uint64_t)k;
+        double h[9], e;
+        home_result res;
+        synth_rng rng;
+        synth_seed(&rng, seed);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 12, h);
+        synth_render(kind, (uint32_t)seed, identity, 2.5, 2 * seed + 1, img_a, IMG_W, IMG_H, IMG_W);
+        synth_render(kind, (uint32_t)seed, h, 2.5, 2 * seed + 2, img_b, IMG_W, IMG_H, IMG_W);
+        CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &fa), HOME_OK);
+        CHECK_EQ_INT(home_extract(ctx, img_b, IMG_W, &fb), HOME_OK);
+        CHECK_EQ_INT(home_match(ctx, &fa, &fb, &res), HOME_OK);
+        CHECK(res.ok);
+        e = synth_corner_error(res.H, h, IMG_W, IMG_H);
+        worst = e > worst ? e : worst;
+    }
+    printf("     video preset, p=12: worst corner error %.3f px of 4 pairs\n", worst);
+    CHECK_LT(worst, 0.3);
+}
+
 void test_end_to_end_weak_texture(void) { end_to_end(SYNTH_WEAK_TEXTURE, 2000); }
 
 void test_video_reuse_matches_pair(void)

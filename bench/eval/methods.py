@@ -206,5 +206,7 @@ def registry(home_exe):
     }
     if home_supports(home_exe, "--no-refine"):
         methods["home-noref"] = HomeCli("HOME (no refinement)", home_exe, ["--no-refine"])
+    if home_supports(home_exe, "--video"):
+        methods["home-video"] = HomeCli("HOME (video preset)", home_exe, ["--video"])
     methods["orb+ecc"] = EccRefined(orb)
     return methods
