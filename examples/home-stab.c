@@ -31,7 +31,7 @@ static void usage(FILE *f)
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
-            "                    its half-size copy (2: default from 320 px)\n"
+            "                    its 1/2 or 1/4 size copy (2, 4; default: the one about 160 px wide)\n"
             "  --side-by-side    write original | stabilised, twice as wide\n"
             "  --csv FILE        per frame: raw and smoothed camera path (tx, ty px, angle rad,\n"
             "                    log scale), share of the correction applied, and the warp\n"
@@ -154,7 +154,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--smoothing")) { target = &smoothing; lo = 1; hi = 1000; }
         else if (!strcmp(a, "--lookahead")) { target = &lookahead; lo = 0; hi = HOME_STAB_MAX_LOOKAHEAD; }
         else if (!strcmp(a, "--downscale")) { target = &downscale; lo = 1; hi = 4; }
-        else if (!strcmp(a, "--hough-downscale")) { target = &hough_ds; lo = 1; hi = 2; }
+        else if (!strcmp(a, "--hough-downscale")) { target = &hough_ds; lo = 1; hi = 4; }
         else if (!strcmp(a, "--keypoints")) { target = &keypoints; lo = 16; hi = HOME_MAX_KEYPOINTS_PER_SIGN; }
         else { fprintf(stderr, "home-stab: unknown option %s (see --help)\n", a); return 2; }
         if (number(argv[++i], lo, hi, target)) {

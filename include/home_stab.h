@@ -65,7 +65,8 @@ typedef struct home_stab_config {
     int refine;               /* 1: HOME's photometric refinement of each H (home_config's
                                  refine_levels default), 0: off */
     int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
-                                 2x2-box downscaled copy (2), see home_config */
+                                 2x2- or 4x4-box downscaled copy (2, 4), see home_config; 0 =
+                                 automatic (home_video_config's: a copy about 160 px wide) */
     int simd;                 /* enum home_simd for HOME and the warp (default: HOME_SIMD env or
                                  the best compiled in) */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
@@ -107,8 +108,9 @@ typedef struct home_stab_output {
 typedef struct home_stab home_stab;
 
 /* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, downscale 2
- * for frames wider than 960 px (else 1), 500 keypoints per sign, refinement on, Hough on the
- * half-size registration image from 320 px wide. */
+ * for frames wider than 960 px (else 1), then home_video_config()'s choices for the registration
+ * image (500 keypoints per sign, automatic hough_downscale: Hough on a copy about 160 px wide)
+ * with 120 theta bins, refinement on. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

@@ -10,6 +10,7 @@
 #define STAB_INIT_VEL_VAR 1.0             /* prior variance of the path velocity, (px/frame)^2 */
 #define STAB_FIT_GRID 5                   /* similarity fitted to H on a 5x5 grid of the frame */
 #define STAB_BISECT_STEPS 30
+#define STAB_THETA_BINS 120               /* HOME's theta bins for video registration */
 
 /* One frame of path history. Path components are normalised to pixels (angle and log scale
  * times the half diagonal) so that one filter covariance serves all four of them. */
@@ -61,15 +62,13 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
     /* registration at full size up to 960 px wide: on the bench's textureless clips, half size
      * (640x360 -> 320x180) left 4x the jitter (0.280 vs 0.070 px) for 1.5x the speed */
     cfg->downscale = width > 960 ? 2 : 1;
-    cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 500 ? HOME_MAX_KEYPOINTS_PER_SIGN : 500;
     cfg->min_inliers = 20;
     cfg->refine = 1;
-    /* the Hough transform on a half-size copy costs a quarter and, measured on the bench clips,
-     * leaves the jitter unchanged once the registration image is 320 px wide or more */
-    cfg->hough_downscale = width / cfg->downscale >= 320 ? 2 : 1;
+    cfg->hough_downscale = 0;   /* automatic: home_video_config's, a copy ~160 px wide */
     {
         home_config h;
-        home_default_config(&h, HOME_MIN_SIDE, HOME_MIN_SIDE);
+        home_video_config(&h, HOME_MIN_SIDE, HOME_MIN_SIDE);
+        cfg->keypoints_per_sign = h.keypoints_per_sign;
         cfg->simd = h.simd;   /* HOME's default, including its HOME_SIMD override */
     }
     cfg->max_shift = 0.15f;
@@ -84,13 +83,18 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
 {
     int f = cfg->downscale, status;
     if (f != 1 && f != 2 && f != 4) return HOME_E_CONFIG;
-    status = home_default_config(h, cfg->width / f, cfg->height / f);
+    status = home_video_config(h, cfg->width / f, cfg->height / f);
     if (status != HOME_OK) return status;
     h->keypoints_per_sign = cfg->keypoints_per_sign;
     h->min_inliers = cfg->min_inliers;
     if (!cfg->refine) h->refine_levels = 0;
-    h->hough_downscale = cfg->hough_downscale;
+    if (cfg->hough_downscale) h->hough_downscale = cfg->hough_downscale;
     h->simd = cfg->simd;
+    /* half the video defaults' theta bins: on the bench clips (also with 10 px / 1 degree
+     * shake) the same jitter to 0.001 px, the Hough transform at half the cost, and at least
+     * 90 inliers per frame (min_inliers 20); the refinement gives the precision */
+    h->wrap_band = h->wrap_band * STAB_THETA_BINS / h->theta_bins;
+    h->theta_bins = STAB_THETA_BINS;
     /* video motion prior: lines rotate by at most max_rotation between frames (+2 bins) */
     h->match_theta_window = (int)ceil(cfg->max_rotation * h->theta_bins / 3.14159265358979) + 2;
     if (h->match_theta_window > h->theta_bins) h->match_theta_window = h->theta_bins;
