@@ -5,7 +5,8 @@ STAB_SUPPORT := $(BUILD)/obj/examples/y4m.o $(BUILD)/obj/examples/stab_png.o $(B
 BINS += $(BUILD)/bin/home-stab $(BUILD)/bin/home-stab-clip $(BUILD)/bin/home-stab-tests
 TEST_BINS += $(BUILD)/bin/home-stab-tests
 
-$(BUILD)/obj/src/stabilise.o $(BUILD)/obj/src/warp.o $(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/stab_*.c)): include/home_stab.h port/stab_kernels.h
+$(BUILD)/obj/src/stabilise.o $(BUILD)/obj/src/warp.o $(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/stab_*.c)): include/home_stab.h port/stab_kernels.h port/stab_x86.h
+$(BUILD)/obj/port/stab_avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 
 $(BUILD)/bin/home-stab: $(BUILD)/obj/examples/home-stab.o $(STAB_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)

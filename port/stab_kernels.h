@@ -44,11 +44,14 @@ extern const home__stab_kernels home__stab_kernels_scalar;
 #if defined(__SSE2__)
 extern const home__stab_kernels home__stab_kernels_sse;
 #endif
+#if defined(__x86_64__) && !defined(HOME_NO_AVX2)
+extern const home__stab_kernels home__stab_kernels_avx2;   /* port/stab_avx2.c, -mavx2 */
+#endif
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 extern const home__stab_kernels home__stab_kernels_neon;
 #endif
 
-/* The table for a home_simd value (AVX2 contexts use SSE2: the gathers bound this kernel), or
- * NULL when that backend is not compiled in. */
+/* The table for a home_simd value (AVX2 contexts: port/stab_avx2.c's), or NULL when that
+ * backend is not compiled in. */
 const home__stab_kernels *home__stab_kernels_for(int simd);
 #endif

@@ -1,0 +1,69 @@
+/* The x86 warp kernels' shared steps (port/stab_sse.c, port/stab_avx2.c): eight output pixels
+ * whose horizontal pairs (p00, p01), (p10, p11) sit as p0 | p1 << 8 in the 16-bit lanes of
+ * top and bottom are blended with the reference's 7-bit weights, its bytes exactly. Weights
+ * come from the coordinates' 16-bit fractions, which wrap like the low halves of the Q16 sums.
+ * Included by one file per instruction set: static inline, so each compiles it with its flags. */
+#ifndef HOME_STAB_X86_H
+#define HOME_STAB_X86_H
+#include "stab_kernels.h"
+#include <emmintrin.h>
+#include <string.h>
+
+static inline int home__stab_load_pair(const uint8_t *p)
+{
+    uint16_t v;
+    memcpy(&v, p, sizeof v);   /* unaligned */
+    return v;
+}
+
+/* low 16 bits of q as the bit pattern of a short (defined for every q, unlike a cast) */
+static inline short home__stab_low16(int32_t q) { return (short)((q & 0x7fff) - (q & 0x8000)); }
+
+/* the fractions (q + k dq) & 0xffff, k = 0..7, in 16-bit lanes */
+static inline __m128i home__stab_fractions(int32_t q, int32_t dq)
+{
+    return _mm_setr_epi16(home__stab_low16(q), home__stab_low16(q + dq), home__stab_low16(q + 2 * dq),
+                          home__stab_low16(q + 3 * dq), home__stab_low16(q + 4 * dq),
+                          home__stab_low16(q + 5 * dq), home__stab_low16(q + 6 * dq),
+                          home__stab_low16(q + 7 * dq));
+}
+
+/* pairs of eight pixels on one source row pair, one 16-bit load each (pinsrw): source x of
+ * pixel k is (x + k dx) >> 16 (x >= 0 there, so unsigned: no sign extensions) */
+static inline void home__stab_gather8(const uint8_t *row, ptrdiff_t stride, uint32_t x, int32_t dx,
+                                      __m128i *top, __m128i *bot)
+{
+    __m128i t = _mm_setzero_si128(), b = _mm_setzero_si128();
+#define HOME__STAB_LANE(k)                                                                  \
+    {                                                                                       \
+        const uint8_t *p = row + (x >> HOME__WARP_FRAC_BITS);                               \
+        t = _mm_insert_epi16(t, home__stab_load_pair(p), k);                                \
+        b = _mm_insert_epi16(b, home__stab_load_pair(p + stride), k);                       \
+        x += (uint32_t)dx;                                                                  \
+    }
+    HOME__STAB_LANE(0) HOME__STAB_LANE(1) HOME__STAB_LANE(2) HOME__STAB_LANE(3)
+    HOME__STAB_LANE(4) HOME__STAB_LANE(5) HOME__STAB_LANE(6) HOME__STAB_LANE(7)
+#undef HOME__STAB_LANE
+    *top = t;
+    *bot = b;
+}
+
+/* blend eight pixels' pairs with the weights of fractions frac_x, frac_y into dst[0..7] */
+static inline void home__stab_blend8(__m128i top, __m128i bot, __m128i frac_x, __m128i frac_y, uint8_t *dst)
+{
+    const __m128i zero = _mm_setzero_si128(), c128 = _mm_set1_epi16(128), low = _mm_set1_epi16(0xff);
+    /* HOME__WARP_WEIGHT of 16-bit fractions: (f + 256) >> 9 = ((f >> 8) + 1) >> 1, pavgw with 0 */
+    const __m128i fx = _mm_avg_epu16(_mm_srli_epi16(frac_x, 8), zero), gx = _mm_sub_epi16(c128, fx);
+    const __m128i fy = _mm_avg_epu16(_mm_srli_epi16(frac_y, 8), zero), gy = _mm_sub_epi16(c128, fy);
+    /* horizontal: p0 (128 - fx) + p1 fx <= 32640, exact in 16 bits */
+    const __m128i t = _mm_add_epi16(_mm_mullo_epi16(_mm_and_si128(top, low), gx), _mm_mullo_epi16(_mm_srli_epi16(top, 8), fx));
+    const __m128i b = _mm_add_epi16(_mm_mullo_epi16(_mm_and_si128(bot, low), gx), _mm_mullo_epi16(_mm_srli_epi16(bot, 8), fx));
+    /* vertical: top (128 - fy) + bot fy in 32 bits, (+ 2^13) >> 14 */
+    __m128i r0 = _mm_madd_epi16(_mm_unpacklo_epi16(t, b), _mm_unpacklo_epi16(gy, fy));
+    __m128i r1 = _mm_madd_epi16(_mm_unpackhi_epi16(t, b), _mm_unpackhi_epi16(gy, fy));
+    r0 = _mm_srli_epi32(_mm_add_epi32(r0, _mm_set1_epi32(8192)), 14);
+    r1 = _mm_srli_epi32(_mm_add_epi32(r1, _mm_set1_epi32(8192)), 14);
+    r0 = _mm_packs_epi32(r0, r1);
+    _mm_storel_epi64((__m128i *)(void *)dst, _mm_packus_epi16(r0, r0));
+}
+#endif
