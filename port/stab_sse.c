@@ -21,13 +21,12 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
     frac_y = home__stab_fractions(y0, dy);
     for (; i + 8 <= n; i += 8, x += 8 * dx, y += 8 * dy) {
         /* affine: the eight pixels share their rows when the first and the last do; else (a
-         * row of the warp crossing a source row: rare) the reference does them */
-        if ((y >> HOME__WARP_FRAC_BITS) != ((y + 7 * dy) >> HOME__WARP_FRAC_BITS)) {
-            home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, 8);
-        } else {
+         * row of the warp crossing a source row) each finds its own */
+        if ((y >> HOME__WARP_FRAC_BITS) == ((y + 7 * dy) >> HOME__WARP_FRAC_BITS))
             home__stab_gather8(src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride, stride, (uint32_t)x, dx, &top, &bot);
-            home__stab_blend8(top, bot, frac_x, frac_y, dst + i);
-        }
+        else
+            home__stab_gather8_rows(src, stride, (uint32_t)x, y, dx, dy, &top, &bot);
+        home__stab_blend8(top, bot, frac_x, frac_y, dst + i);
         frac_x = _mm_add_epi16(frac_x, step_x);
         frac_y = _mm_add_epi16(frac_y, step_y);
     }

@@ -48,6 +48,26 @@ static inline void home__stab_gather8(const uint8_t *row, ptrdiff_t stride, uint
     *bot = b;
 }
 
+/* the same for eight pixels whose source rows differ (a warp row crossing a source row) */
+static inline void home__stab_gather8_rows(const uint8_t *src, ptrdiff_t stride, uint32_t x, int32_t y,
+                                           int32_t dx, int32_t dy, __m128i *top, __m128i *bot)
+{
+    __m128i t = _mm_setzero_si128(), b = _mm_setzero_si128();
+#define HOME__STAB_LANE(k)                                                                  \
+    {                                                                                       \
+        const uint8_t *p = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride + (x >> HOME__WARP_FRAC_BITS); \
+        t = _mm_insert_epi16(t, home__stab_load_pair(p), k);                                \
+        b = _mm_insert_epi16(b, home__stab_load_pair(p + stride), k);                       \
+        x += (uint32_t)dx;                                                                  \
+        y += dy;                                                                            \
+    }
+    HOME__STAB_LANE(0) HOME__STAB_LANE(1) HOME__STAB_LANE(2) HOME__STAB_LANE(3)
+    HOME__STAB_LANE(4) HOME__STAB_LANE(5) HOME__STAB_LANE(6) HOME__STAB_LANE(7)
+#undef HOME__STAB_LANE
+    *top = t;
+    *bot = b;
+}
+
 /* blend eight pixels' pairs with the weights of fractions frac_x, frac_y into dst[0..7] */
 static inline void home__stab_blend8(__m128i top, __m128i bot, __m128i frac_x, __m128i frac_y, uint8_t *dst)
 {
