@@ -75,7 +75,7 @@ static void smooth_cols_avx2(const float *const *rows, float *out, int n, const 
 }
 
 const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
-                                          smooth_row_avx2, smooth_cols_avx2,
+                                          smooth_row_avx2, smooth_cols_avx2, home__box_down_sse,
     &home__refine_kernels_sse, &home__stab_kernels_sse};
 #else
 typedef int home__avx2_unavailable; /* ISO C forbids an empty translation unit */

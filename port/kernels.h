@@ -37,6 +37,10 @@ typedef struct home__kernels {
     /* out[i] = sum_k taps[k] * rows[k][i] (k = 0 .. 2 radius, in this order), i in [0, n). */
     void (*smooth_cols)(const float *const *rows, float *out, int n, const float *taps,
                         int radius);
+    /* One row of a ds x ds box downscale (ds = 2 or 4), rounded:
+     *   out[x] = (sum over v, u < ds of src[v*stride + ds*x + u] + ds*ds/2) / (ds*ds),
+     * x in [0, out_w). */
+    void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
     /* the photometric refinement's and the stabiliser's kernels of the same backend */
     const struct home__refine_kernels *refine;
     const struct home__stab_kernels *stab;
@@ -46,12 +50,13 @@ extern const home__kernels home__kernels_scalar;
 #if defined(__SSE2__)
 #define HOME__HAVE_SSE 1
 extern const home__kernels home__kernels_sse;
-/* shared by the AVX2 table, which only replaces the Radon kernel */
+/* shared by the AVX2 table */
 void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
                            int *best, int *d1, int *d2);
 void home__smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius);
 void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
                            int radius);
+void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
 #endif
 #if defined(__x86_64__) && !defined(HOME_NO_AVX2)
 /* port/avx2.c is compiled with -mavx2 and used only when the CPU reports AVX2 */

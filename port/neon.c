@@ -83,8 +83,34 @@ static void smooth_cols_neon(const float *const *rows, float *out, int n, const 
     }
 }
 
+/* 8 outputs per step: pairwise widening adds along the row, accumulated over the rows, then a
+ * rounding narrowing shift ((sum + half) >> shift); the tail by the reference. */
+static void box_down_neon(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
+{
+    int x = 0, v;
+    if (ds == 4) {
+        for (; x + 8 <= out_w; x += 8) {
+            const uint8_t *s0 = src + 4 * x;
+            uint16x8_t lo = vpaddlq_u8(vld1q_u8(s0)), hi = vpaddlq_u8(vld1q_u8(s0 + 16));
+            for (v = 1; v < 4; v++) {
+                lo = vpadalq_u8(lo, vld1q_u8(s0 + (ptrdiff_t)v * stride));
+                hi = vpadalq_u8(hi, vld1q_u8(s0 + (ptrdiff_t)v * stride + 16));
+            }
+            vst1_u8(out + x, vmovn_u16(vcombine_u16(vrshrn_n_u32(vpaddlq_u16(lo), 4),
+                                                    vrshrn_n_u32(vpaddlq_u16(hi), 4))));
+        }
+    } else {
+        for (; x + 8 <= out_w; x += 8) {
+            const uint8_t *s0 = src + 2 * x;
+            uint16x8_t sum = vpadalq_u8(vpaddlq_u8(vld1q_u8(s0)), vld1q_u8(s0 + stride));
+            vst1_u8(out + x, vrshrn_n_u16(sum, 2));
+        }
+    }
+    if (x < out_w) home__kernels_scalar.box_down(src + ds * x, stride, ds, out + x, out_w - x);
+}
+
 const home__kernels home__kernels_neon = {"neon", radon_blocks_neon, nearest2_l1_neon,
-                                          smooth_row_neon, smooth_cols_neon,
+                                          smooth_row_neon, smooth_cols_neon, box_down_neon,
     &home__refine_kernels_neon, &home__stab_kernels_neon};
 #else
 typedef int home__neon_unavailable; /* ISO C forbids an empty translation unit */

@@ -54,6 +54,18 @@ static void smooth_cols_scalar(const float *const *rows, float *out, int n, cons
     }
 }
 
+static void box_down_scalar(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
+{
+    const int shift = ds == 2 ? 2 : 4;
+    int x, u, v;
+    for (x = 0; x < out_w; x++) {
+        int sum = 1 << (shift - 1);
+        for (v = 0; v < ds; v++)
+            for (u = 0; u < ds; u++) sum += src[(ptrdiff_t)v * stride + ds * x + u];
+        out[x] = (uint8_t)(sum >> shift);
+    }
+}
+
 const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
-                                            smooth_row_scalar, smooth_cols_scalar,
+                                            smooth_row_scalar, smooth_cols_scalar, box_down_scalar,
     &home__refine_kernels_scalar, &home__stab_kernels_scalar};

@@ -84,8 +84,44 @@ void home__smooth_cols_sse(const float *const *rows, float *out, int n, const fl
     }
 }
 
+/* 16 outputs per step: rows summed in 16-bit lanes, neighbours paired by pmaddwd with ones (twice
+ * for ds = 4), rounded and packed back to bytes; the tail by the reference. */
+void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
+{
+    const __m128i zero = _mm_setzero_si128(), ones = _mm_set1_epi16(1);
+    const int shift = ds == 2 ? 2 : 4;
+    const __m128i half = _mm_set1_epi32(1 << (shift - 1));
+    int x = 0, v, c;
+    for (; x + 16 <= out_w; x += 16) {
+        __m128i q[4]; /* four outputs per 32-bit lane group */
+        for (c = 0; c < 4; c++) {
+            /* the source bytes of outputs x + 4c .. x + 4c + 3 */
+            const uint8_t *s0 = src + ds * (x + 4 * c);
+            __m128i pairs;
+            if (ds == 4) {
+                __m128i lo = zero, hi = zero;
+                for (v = 0; v < 4; v++) {
+                    __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(s0 + (ptrdiff_t)v * stride));
+                    lo = _mm_add_epi16(lo, _mm_unpacklo_epi8(b, zero));
+                    hi = _mm_add_epi16(hi, _mm_unpackhi_epi8(b, zero));
+                }
+                pairs = _mm_packs_epi32(_mm_madd_epi16(lo, ones), _mm_madd_epi16(hi, ones));
+                q[c] = _mm_madd_epi16(pairs, ones);
+            } else {
+                __m128i b0 = _mm_loadl_epi64((const __m128i *)(const void *)s0);
+                __m128i b1 = _mm_loadl_epi64((const __m128i *)(const void *)(s0 + stride));
+                q[c] = _mm_madd_epi16(_mm_add_epi16(_mm_unpacklo_epi8(b0, zero), _mm_unpacklo_epi8(b1, zero)), ones);
+            }
+            q[c] = _mm_srai_epi32(_mm_add_epi32(q[c], half), shift);
+        }
+        _mm_storeu_si128((__m128i *)(void *)(out + x),
+                         _mm_packus_epi16(_mm_packs_epi32(q[0], q[1]), _mm_packs_epi32(q[2], q[3])));
+    }
+    if (x < out_w) home__kernels_scalar.box_down(src + ds * x, stride, ds, out + x, out_w - x);
+}
+
 const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, home__nearest2_l1_sse,
-                                         home__smooth_row_sse, home__smooth_cols_sse,
+                                         home__smooth_row_sse, home__smooth_cols_sse, home__box_down_sse,
     &home__refine_kernels_sse, &home__stab_kernels_sse};
 #else
 typedef int home__sse_unavailable; /* ISO C forbids an empty translation unit */

@@ -52,25 +52,10 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
     for (y = 0; y < height; y++) {
         uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
         memset(row, 0, (size_t)pad);
-        if (ds > 1) {
-            /* box average, rounded: ds*ds is 4 or 16, so the division is a shift; the ds rows
-             * are summed in 4-byte groups into line_sum (at least hough_w long) */
-            const int shift = ds == 2 ? 2 : 4;
-            int32_t *acc = ctx->line_sum;
-            int v;
-            for (x = 0; x < width; x++) acc[x] = 0;
-            for (v = 0; v < ds; v++) {
-                const uint8_t *src = image + (ptrdiff_t)(ds * y + v) * stride;
-                if (ds == 2)
-                    for (x = 0; x < width; x++) acc[x] += src[2 * x] + src[2 * x + 1];
-                else
-                    for (x = 0; x < width; x++)
-                        acc[x] += src[4 * x] + src[4 * x + 1] + src[4 * x + 2] + src[4 * x + 3];
-            }
-            for (x = 0; x < width; x++) row[pad + x] = (uint8_t)((acc[x] + (1 << (shift - 1))) >> shift);
-        } else {
+        if (ds > 1)
+            ctx->kernels->box_down(image + (ptrdiff_t)(ds * y) * stride, stride, ds, row + pad, width);
+        else
             memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
-        }
         memset(row + pad + width, 0, (size_t)pad);
     }
     for (x = 0; x < width; x++) {

@@ -119,6 +119,41 @@ void test_kernels_smooth(void)
     }
 }
 
+/* The box downscale: the reference against direct sums, then every backend against it, at
+ * odd output widths (SIMD bodies and tails), unaligned rows, extreme and random bytes. */
+void test_kernels_box_down(void)
+{
+    enum { W = 4 * 77 + 3, ROWS = 4, STRIDE = W + 9 };
+    static uint8_t image[ROWS * STRIDE + 16], want[W], got[W];
+    synth_rng rng;
+    int trial;
+    synth_seed(&rng, 23);
+    for (trial = 0; trial < 60; trial++) {
+        const int ds = trial & 1 ? 4 : 2, out_w = 1 + (trial * 13) % (W / ds), offset = trial % 7;
+        const uint8_t *src = image + offset;
+        size_t bi;
+        int p, x, u, v, exact = 1;
+        for (p = 0; p < ROWS * STRIDE + 16; p++) image[p] = random_byte(&rng, trial % 5 == 0);
+        if (trial % 10 == 9) memset(image, 255, sizeof image); /* the largest sums */
+        home__kernels_scalar.box_down(src, STRIDE, ds, want, out_w);
+        for (x = 0; x < out_w; x++) {
+            int sum = 0;
+            for (v = 0; v < ds; v++)
+                for (u = 0; u < ds; u++) sum += src[v * STRIDE + ds * x + u];
+            exact &= want[x] == (uint8_t)((sum + ds * ds / 2) / (ds * ds));
+        }
+        CHECK(exact);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *kr = home__kernels_for(backends[bi]);
+            if (!kr) continue;
+            memset(got, 0xAA, sizeof got);
+            kr->box_down(src, STRIDE, ds, got, out_w);
+            CHECK(memcmp(want, got, (size_t)out_w) == 0);
+            CHECK(got[out_w] == 0xAA); /* nothing written past the row */
+        }
+    }
+}
+
 void test_backends_identical_output(void)
 {
     /* the whole registration is bit-identical on every compiled backend */
