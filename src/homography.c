@@ -15,7 +15,7 @@ typedef struct line_problem {
     const home__match *matches;
     const int *index;        /* the inliers the fit runs over */
     int n;
-    double scale;            /* half diagonal, px: normalises r */
+    double scale, inv_scale; /* half diagonal, px: normalises r */
     double w_theta, w_r;     /* residual weights into Hough bins */
 } line_problem;
 
@@ -26,23 +26,24 @@ static void line_residual(const line_problem *lp, const home__match *m, const do
                           double *e, double *k)
 {
     double l0 = m->cos_a, l1 = m->sin_a;
-    double l2 = -(double)m->r_a / lp->scale;
+    double l2 = -(double)m->r_a * lp->inv_scale;
     double a = g[0] * l0 + g[1] * l1 + g[2] * l2;
     double b = g[3] * l0 + g[4] * l1 + g[5] * l2;
     double c = g[6] * l0 + g[7] * l1 + l2;
-    double nn = a * a + b * b, n = sqrt(nn);
-    if (!(n > 1e-12)) n = 1e-12, nn = n * n;
-    e[0] = lp->w_theta * (a / n - m->cos_b);
-    e[1] = lp->w_theta * (b / n - m->sin_b);
-    e[2] = lp->w_r * (c / n + (double)m->r_b / lp->scale);
+    double n = sqrt(a * a + b * b), inv_n;
+    if (!(n > 1e-12)) n = 1e-12;
+    inv_n = 1.0 / n; /* one division: the residual and its Jacobian are latency bound */
+    e[0] = lp->w_theta * (a * inv_n - m->cos_b);
+    e[1] = lp->w_theta * (b * inv_n - m->sin_b);
+    e[2] = lp->w_r * (c * inv_n + (double)m->r_b * lp->inv_scale);
     if (k) {
-        double n3 = nn * n;
-        k[0] = lp->w_theta * b * b / n3;
-        k[1] = -lp->w_theta * a * b / n3;
-        k[2] = lp->w_theta * a * a / n3;
-        k[3] = -lp->w_r * c * a / n3;
-        k[4] = -lp->w_r * c * b / n3;
-        k[5] = lp->w_r / n;
+        const double inv_n3 = inv_n * inv_n * inv_n, wt = lp->w_theta * inv_n3, wr = lp->w_r * inv_n3;
+        k[0] = wt * b * b;
+        k[1] = -wt * a * b;
+        k[2] = wt * a * a;
+        k[3] = -wr * c * a;
+        k[4] = -wr * c * b;
+        k[5] = lp->w_r * inv_n;
     }
 }
 
@@ -61,7 +62,7 @@ static double line_normal(const void *user, const double *g, double *jtj, double
         line_residual(lp, m, g, e, jtj ? k : NULL);
         cost += e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
         if (jtj) {
-            const double l[3] = {m->cos_a, m->sin_a, -(double)m->r_a / lp->scale};
+            const double l[3] = {m->cos_a, m->sin_a, -(double)m->r_a * lp->inv_scale};
             const double ll[6] = {l[0] * l[0], l[0] * l[1], l[0] * l[2],
                                   l[1] * l[1], l[1] * l[2], l[2] * l[2]};
             const double s[6] = {k[0] * k[0] + k[1] * k[1] + k[3] * k[3],
@@ -155,6 +156,7 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     lp.index = ctx->inlier_index;
     lp.n = 0;
     lp.scale = sqrt(cx * cx + cy * cy);
+    lp.inv_scale = 1.0 / lp.scale;
     lp.w_theta = cfg->theta_bins / HOME__PI;
     lp.w_r = lp.scale / (cfg->r_step * ctx->hough_scale); /* Hough bins of the transform */
     set_identity(result->H);
