@@ -49,7 +49,7 @@ static void group8(const uint8_t *src, ptrdiff_t stride, int32_t x, int32_t y, i
 static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                           int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
-    const __m256i step_x = _mm256_set1_epi16(home__stab_low16(16 * dx)), step_y = _mm256_set1_epi16(home__stab_low16(16 * dy));
+    const __m256i step_x = _mm256_set1_epi16(home__stab_low16(0, dx, 16)), step_y = _mm256_set1_epi16(home__stab_low16(0, dy, 16));
     const __m256i pair = _mm256_set1_epi16(0x0100);
     __m256i frac_x, frac_y, off0, off1;
     int32_t x = x0, y = y0;
@@ -58,8 +58,11 @@ static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w,
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
-    frac_x = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions(x0, dx)), home__stab_fractions(x0 + 8 * dx, dx), 1);
-    frac_y = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions(y0, dy)), home__stab_fractions(y0 + 8 * dy, dy), 1);
+    /* pixels 0-7 | 8-15 (the start wraps like the fractions: rows shorter than 16 never use it) */
+    frac_x = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions((uint32_t)x0, dx)),
+                                     home__stab_fractions((uint32_t)x0 + 8u * (uint32_t)dx, dx), 1);
+    frac_y = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions((uint32_t)y0, dy)),
+                                     home__stab_fractions((uint32_t)y0 + 8u * (uint32_t)dy, dy), 1);
     /* pixel k's offset k dx from its group's first pixel: k = 0-3 in off0, 4-7 in off1, per lane */
     off0 = _mm256_setr_epi32(0, dx, 2 * dx, 3 * dx, 0, dx, 2 * dx, 3 * dx);
     off1 = _mm256_add_epi32(off0, _mm256_set1_epi32(4 * dx));

@@ -19,7 +19,7 @@ static uint16x8_t fractions(int32_t q, int32_t dq)
 {
     uint16_t f[8];
     int k;
-    for (k = 0; k < 8; k++) f[k] = (uint16_t)(q + k * dq);
+    for (k = 0; k < 8; k++) f[k] = (uint16_t)((uint32_t)q + (uint32_t)k * (uint32_t)dq);   /* wraps */
     return vld1q_u16(f);
 }
 
@@ -28,7 +28,7 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w,
 {
     const uint8x8_t c128 = vdup_n_u8(128);
     const uint16x8_t c128w = vdupq_n_u16(128);
-    const uint16x8_t step_x = vdupq_n_u16((uint16_t)(8 * dx)), step_y = vdupq_n_u16((uint16_t)(8 * dy));
+    const uint16x8_t step_x = vdupq_n_u16((uint16_t)(8u * (uint32_t)dx)), step_y = vdupq_n_u16((uint16_t)(8u * (uint32_t)dy));
     uint16x8_t frac_x, frac_y;
     int32_t x = x0, y = y0;
     int i = 0;

@@ -9,7 +9,7 @@
 static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                          int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
-    const __m128i step_x = _mm_set1_epi16(home__stab_low16(8 * dx)), step_y = _mm_set1_epi16(home__stab_low16(8 * dy));
+    const __m128i step_x = _mm_set1_epi16(home__stab_low16(0, dx, 8)), step_y = _mm_set1_epi16(home__stab_low16(0, dy, 8));
     __m128i frac_x, frac_y, top, bot;
     int32_t x = x0, y = y0;
     int i = 0;
@@ -17,8 +17,8 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
-    frac_x = home__stab_fractions(x0, dx);
-    frac_y = home__stab_fractions(y0, dy);
+    frac_x = home__stab_fractions((uint32_t)x0, dx);
+    frac_y = home__stab_fractions((uint32_t)y0, dy);
     for (; i + 8 <= n; i += 8, x += 8 * dx, y += 8 * dy) {
         /* affine: the eight pixels share their rows when the first and the last do; else (a
          * row of the warp crossing a source row) each finds its own */

@@ -16,16 +16,20 @@ static inline int home__stab_load_pair(const uint8_t *p)
     return v;
 }
 
-/* low 16 bits of q as the bit pattern of a short (defined for every q, unlike a cast) */
-static inline short home__stab_low16(int32_t q) { return (short)((q & 0x7fff) - (q & 0x8000)); }
+/* low 16 bits of q + k dq (wrapping: defined past the row's end too) as the bit pattern of a
+ * short (defined for every value, unlike a cast) */
+static inline short home__stab_low16(uint32_t q, int32_t dq, int k)
+{
+    const uint32_t v = q + (uint32_t)k * (uint32_t)dq;
+    return (short)((int)(v & 0x7fff) - (int)(v & 0x8000));
+}
 
 /* the fractions (q + k dq) & 0xffff, k = 0..7, in 16-bit lanes */
-static inline __m128i home__stab_fractions(int32_t q, int32_t dq)
+static inline __m128i home__stab_fractions(uint32_t q, int32_t dq)
 {
-    return _mm_setr_epi16(home__stab_low16(q), home__stab_low16(q + dq), home__stab_low16(q + 2 * dq),
-                          home__stab_low16(q + 3 * dq), home__stab_low16(q + 4 * dq),
-                          home__stab_low16(q + 5 * dq), home__stab_low16(q + 6 * dq),
-                          home__stab_low16(q + 7 * dq));
+    return _mm_setr_epi16(home__stab_low16(q, dq, 0), home__stab_low16(q, dq, 1), home__stab_low16(q, dq, 2),
+                          home__stab_low16(q, dq, 3), home__stab_low16(q, dq, 4), home__stab_low16(q, dq, 5),
+                          home__stab_low16(q, dq, 6), home__stab_low16(q, dq, 7));
 }
 
 /* pairs of eight pixels on one source row pair, one 16-bit load each (pinsrw): source x of
