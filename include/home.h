@@ -79,7 +79,8 @@ typedef struct home_config {
     float ratio;              /* Lowe ratio test; 0.9 (paper's baselines used 0.75) */
     float threshold_start;    /* first inlier threshold, Hough pixels; halved down to ... */
     float threshold_final;    /* ... this final threshold; paper: 1.0 */
-    int min_inliers;          /* fewer final inliers -> failure; paper: 20 */
+    int min_inliers;          /* fewer final inliers -> failure; paper: 20 (twice this with
+                                 hough_downscale > 1, see the failure rule in README) */
     /* photometric refinement of HOME's H (home_refine() below); refine_levels = 0 turns it off */
     int refine_levels;        /* pyramid levels, 1..HOME_REFINE_MAX_LEVELS; default 3 */
     int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
@@ -162,7 +163,8 @@ enum home_stage {
 enum home_failure {
     HOME_FAIL_NONE = 0,
     HOME_FAIL_FEW_MATCHES,    /* too few matches to estimate a homography */
-    HOME_FAIL_FEW_INLIERS,    /* fewer than min_inliers at the final threshold */
+    HOME_FAIL_FEW_INLIERS,    /* fewer than min_inliers (2x with hough_downscale > 1) at the
+                                 final threshold */
     HOME_FAIL_DEGENERATE      /* det(H / H22) <= 0, an image corner mapped behind the camera
                                  (w <= 0), or a numerically unusable estimate */
 };
