@@ -1,7 +1,8 @@
 /* NEON warp row kernel: the SSE2 kernel's scheme (port/stab_sse.c) - eight output pixels per
- * step, each pixel's horizontal pairs one 16-bit load from rows shared by the eight, weights from
- * 16-bit fractions - with widening multiplies and rounding narrowing shifts that give the
- * reference's bytes exactly. Rows that need clamping, or are not planar, use the reference. */
+ * step, each pixel's horizontal pairs one 16-bit load from rows shared by the eight (or its own
+ * where the eight cross a source row), weights from 16-bit fractions - with widening multiplies
+ * and rounding narrowing shifts that give the reference's bytes exactly. Rows that need
+ * clamping, or are not planar, use the reference. */
 #include "stab_kernels.h"
 #include <string.h>
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
@@ -42,22 +43,28 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w,
         uint16x8_t top = vdupq_n_u16(0), bot = vdupq_n_u16(0), t, b, fy, gy;
         uint8x8_t fx, gx;
         uint32x4_t r0, r1;
-        const uint8_t *row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
         uint32_t xs = (uint32_t)x;   /* >= 0 in an inside row */
-        if ((y >> HOME__WARP_FRAC_BITS) != ((y + 7 * dy) >> HOME__WARP_FRAC_BITS)) {
-            home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, 8);   /* rows differ */
-            frac_x = vaddq_u16(frac_x, step_x);
-            frac_y = vaddq_u16(frac_y, step_y);
-            continue;
-        }
-#define NEON_LANE(k)                                                                       \
+        int32_t ys = y;
+        /* affine: the eight pixels share their rows when the first and the last do; else (a
+         * row of the warp crossing a source row) each finds its own */
+#define NEON_LANE(k, row)                                                                  \
     {                                                                                      \
-        const uint8_t *p = row + (xs >> HOME__WARP_FRAC_BITS);                             \
+        const uint8_t *p = (row) + (xs >> HOME__WARP_FRAC_BITS);                           \
         top = vsetq_lane_u16(load_pair(p), top, k);                                        \
         bot = vsetq_lane_u16(load_pair(p + stride), bot, k);                               \
         xs += (uint32_t)dx;                                                                \
+        ys += dy;                                                                          \
     }
-        NEON_LANE(0) NEON_LANE(1) NEON_LANE(2) NEON_LANE(3) NEON_LANE(4) NEON_LANE(5) NEON_LANE(6) NEON_LANE(7)
+        if ((y >> HOME__WARP_FRAC_BITS) == ((y + 7 * dy) >> HOME__WARP_FRAC_BITS)) {
+            const uint8_t *row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+            NEON_LANE(0, row) NEON_LANE(1, row) NEON_LANE(2, row) NEON_LANE(3, row)
+            NEON_LANE(4, row) NEON_LANE(5, row) NEON_LANE(6, row) NEON_LANE(7, row)
+        } else {
+#define NEON_ROW (src + (ptrdiff_t)(ys >> HOME__WARP_FRAC_BITS) * stride)
+            NEON_LANE(0, NEON_ROW) NEON_LANE(1, NEON_ROW) NEON_LANE(2, NEON_ROW) NEON_LANE(3, NEON_ROW)
+            NEON_LANE(4, NEON_ROW) NEON_LANE(5, NEON_ROW) NEON_LANE(6, NEON_ROW) NEON_LANE(7, NEON_ROW)
+#undef NEON_ROW
+        }
 #undef NEON_LANE
         /* HOME__WARP_WEIGHT: vrshr computes (f + 256) >> 9 without overflowing 16 bits */
         fx = vmovn_u16(vrshrq_n_u16(frac_x, 9));
