@@ -51,9 +51,5 @@ const home__refine_kernels *home__refine_kernels_for(int simd)
 const home__stab_kernels *home__stab_kernels_for(int simd)
 {
     const home__kernels *k = home__kernels_for(simd);
-#ifdef HOME__HAVE_AVX2
-    /* the AVX2 table (port/avx2.c) carries the SSE2 warp; its shuffle version lives apart */
-    if (k == &home__kernels_avx2) return &home__stab_kernels_avx2;
-#endif
     return k ? k->stab : NULL;
 }
