@@ -11,6 +11,17 @@ static uint8_t img_a[IMG_W * IMG_H], img_b[IMG_W * IMG_H];
 static home_features fa, fb;
 static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 
+/* A pair of `kind` scene `seed` with a random corner motion of up to p px: img_a, img_b and
+ * the true homography h (A -> B); noise sigma 2.5, its own seed per image. */
+static void render_pair(enum synth_kind kind, uint64_t seed, double p, double *h)
+{
+    synth_rng rng;
+    synth_seed(&rng, seed);
+    synth_corner_homography(&rng, IMG_W, IMG_H, p, h);
+    synth_render(kind, (uint32_t)seed, identity, 2.5, 2 * seed + 1, img_a, IMG_W, IMG_H, IMG_W);
+    synth_render(kind, (uint32_t)seed, h, 2.5, 2 * seed + 2, img_b, IMG_W, IMG_H, IMG_W);
+}
+
 /* Register n_pairs pairs of `kind` per p and check the mean corner error and no failures. */
 static void end_to_end(enum synth_kind kind, uint64_t seed0)
 {
@@ -25,11 +36,7 @@ static void end_to_end(enum synth_kind kind, uint64_t seed0)
             uint64_t seed = seed0 + 100 * pi + (uint64_t)k;
             double h[9], err;
             home_result res;
-            synth_rng rng;
-            synth_seed(&rng, seed);
-            synth_corner_homography(&rng, IMG_W, IMG_H, ps[pi], h);
-            synth_render(kind, (uint32_t)seed, identity, 2.5, 2 * seed + 1, img_a, IMG_W, IMG_H, IMG_W);
-            synth_render(kind, (uint32_t)seed, h, 2.5, 2 * seed + 2, img_b, IMG_W, IMG_H, IMG_W);
+            render_pair(kind, seed, ps[pi], h);
             CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
             err = synth_corner_error(res.H, h, IMG_W, IMG_H);
             if (!res.ok) failures++;
@@ -66,11 +73,7 @@ static void downscaled_hough(int downscale, int refine_levels, double bound)
         uint64_t seed = 3000 + (uint64_t)k;
         double h[9];
         home_result res;
-        synth_rng rng;
-        synth_seed(&rng, seed);
-        synth_corner_homography(&rng, IMG_W, IMG_H, 20, h);
-        synth_render(SYNTH_STRUCTURED, (uint32_t)seed, identity, 2.5, 2 * seed + 1, img_a, IMG_W, IMG_H, IMG_W);
-        synth_render(SYNTH_STRUCTURED, (uint32_t)seed, h, 2.5, 2 * seed + 2, img_b, IMG_W, IMG_H, IMG_W);
+        render_pair(SYNTH_STRUCTURED, seed, 20, h);
         CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
         failures += !res.ok;
         sum += synth_corner_error(res.H, h, IMG_W, IMG_H);
@@ -122,11 +125,7 @@ void test_video_config(void)
         uint64_t seed = 4100 + (uint64_t)k;
         double h[9], e;
         home_result res;
-        synth_rng rng;
-        synth_seed(&rng, seed);
-        synth_corner_homography(&rng, IMG_W, IMG_H, 12, h);
-        synth_render(kind, (uint32_t)seed, identity, 2.5, 2 * seed + 1, img_a, IMG_W, IMG_H, IMG_W);
-        synth_render(kind, (uint32_t)seed, h, 2.5, 2 * seed + 2, img_b, IMG_W, IMG_H, IMG_W);
+        render_pair(kind, seed, 12, h);
         CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &fa), HOME_OK);
         CHECK_EQ_INT(home_extract(ctx, img_b, IMG_W, &fb), HOME_OK);
         CHECK_EQ_INT(home_match(ctx, &fa, &fb, &res), HOME_OK);
