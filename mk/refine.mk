@@ -22,6 +22,7 @@ $(REFINE_PAIR): $(BUILD)/obj/bench/refine/refine-pair.o $(SUPPORT_OBJ) $(LIB)
 # port/refine_kernels.h is not in the generic object rules' prerequisites
 $(BUILD)/obj/src/refine.o $(BUILD)/obj/src/arena.o $(BUILD)/obj/src/pipeline.o $(BUILD)/obj/tests/test_refine.o: port/refine_kernels.h
 $(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/refine_*.c)): port/refine_kernels.h
+$(BUILD)/obj/port/refine_avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 
 # make bench-refine: per-frame cost of the refinement (video case) next to HOME alone
 REFINE_BENCH := $(BUILD)/bin/home-bench-refine

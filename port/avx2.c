@@ -1,6 +1,7 @@
 /* AVX2 kernels (x86-64 CPUs that report AVX2; compiled with -mavx2): the Radon accumulation and
- * the Gaussian smoothing of the Hough image gained from wider vectors, and the stabiliser's warp
- * (port/stab_avx2.c); the other kernels of this table are the SSE2 ones. */
+ * the Gaussian smoothing of the Hough image gained from wider vectors, as did the refinement's
+ * blur and keys (port/refine_avx2.c) and the stabiliser's warp (port/stab_avx2.c); the other
+ * kernels of this table are the SSE2 ones. */
 #include "kernels.h"
 #include "refine_kernels.h"
 #include "stab_kernels.h"
@@ -76,7 +77,7 @@ static void smooth_cols_avx2(const float *const *rows, float *out, int n, const 
 
 const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
                                           smooth_row_avx2, smooth_cols_avx2, home__box_down_sse,
-    &home__refine_kernels_sse, &home__stab_kernels_avx2};
+    &home__refine_kernels_avx2, &home__stab_kernels_avx2};
 #else
 typedef int home__avx2_unavailable; /* ISO C forbids an empty translation unit */
 #endif

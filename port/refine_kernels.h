@@ -54,6 +54,22 @@ typedef struct home__refine_kernels {
 extern const home__refine_kernels home__refine_kernels_scalar;
 #if defined(__SSE2__)
 extern const home__refine_kernels home__refine_kernels_sse;
+/* shared by the AVX2 table (port/refine_avx2.c), which replaces the blur and the keys */
+void home__refine_downsample_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                                 ptrdiff_t dst_stride, int dst_w, int dst_h);
+void home__refine_warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n,
+                           const uint8_t *img, ptrdiff_t stride, int w, int h, float *out);
+void home__refine_accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
+                                 const int16_t *gys, const float *r, const float *w, int n,
+                                 const float *aff, float *acc);
+int home__refine_cauchy_sums_sse(const float *b, const float *keep, const int16_t *t, int n,
+                                 int n_valid, float alpha, float beta, float inv_c, float *wt,
+                                 float *part);
+void home__refine_residuals_sse(const float *b, const int16_t *t, const float *wt, int n,
+                                float alpha, float beta, float *res);
+#endif
+#if defined(__x86_64__) && !defined(HOME_NO_AVX2)
+extern const home__refine_kernels home__refine_kernels_avx2; /* port/refine_avx2.c, -mavx2 */
 #endif
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 extern const home__refine_kernels home__refine_kernels_neon;

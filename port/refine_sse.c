@@ -39,8 +39,8 @@ static void blur3_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst, pt
     }
 }
 
-static void downsample_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
-                           ptrdiff_t dst_stride, int dst_w, int dst_h)
+void home__refine_downsample_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                                 ptrdiff_t dst_stride, int dst_w, int dst_h)
 {
     const __m128i lo = _mm_set1_epi16(0xff), two = _mm_set1_epi16(2);
     int x, y;
@@ -96,8 +96,8 @@ static __m128 load4_s16(const int16_t *p)
     return _mm_cvtepi32_ps(_mm_srai_epi32(_mm_unpacklo_epi16(v, v), 16));
 }
 
-static void warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n,
-                     const uint8_t *img, ptrdiff_t stride, int w, int h, float *out)
+void home__refine_warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n,
+                           const uint8_t *img, ptrdiff_t stride, int w, int h, float *out)
 {
     const __m128 xmax = _mm_set1_ps((float)(w - 1)), ymax = _mm_set1_ps((float)(h - 1));
     const __m128 zero = _mm_setzero_ps(), minus1 = _mm_set1_ps(-1.0f);
@@ -144,9 +144,9 @@ static void warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n
     }
 }
 
-static void accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
-                           const int16_t *gys, const float *r, const float *w, int n,
-                           const float *aff, float *acc)
+void home__refine_accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
+                                 const int16_t *gys, const float *r, const float *w, int n,
+                                 const float *aff, float *acc)
 {
     const __m128 a = _mm_set1_ps(aff[0]), bu = _mm_set1_ps(aff[1]), bv = _mm_set1_ps(aff[2]);
     const __m128 sign = _mm_set1_ps(-0.0f);
@@ -172,8 +172,9 @@ static void accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *
     for (k = 0; k < HOME__REFINE_ACC; k++) _mm_storeu_ps(acc + k * HOME__REFINE_LANES, sum[k]);
 }
 
-static int cauchy_sums_sse(const float *b, const float *keep, const int16_t *t, int n, int n_valid,
-                           float alpha, float beta, float inv_c, float *wt, float *part)
+int home__refine_cauchy_sums_sse(const float *b, const float *keep, const int16_t *t, int n,
+                                 int n_valid, float alpha, float beta, float inv_c, float *wt,
+                                 float *part)
 {
     const __m128 va = _mm_set1_ps(alpha), vbeta = _mm_set1_ps(beta), vc = _mm_set1_ps(inv_c);
     const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
@@ -207,8 +208,8 @@ static int cauchy_sums_sse(const float *b, const float *keep, const int16_t *t, 
     return c[0] + c[1] + c[2] + c[3];
 }
 
-static void residuals_sse(const float *b, const int16_t *t, const float *wt, int n, float alpha,
-                          float beta, float *res)
+void home__refine_residuals_sse(const float *b, const int16_t *t, const float *wt, int n,
+                                float alpha, float beta, float *res)
 {
     const __m128 va = _mm_set1_ps(alpha), vbeta = _mm_set1_ps(beta), zero = _mm_setzero_ps();
     int i;
@@ -219,8 +220,8 @@ static void residuals_sse(const float *b, const int16_t *t, const float *wt, int
 }
 
 const home__refine_kernels home__refine_kernels_sse = {
-    "sse", blur3_sse, downsample_sse, select_keys_sse, warp_sse, accumulate_sse, cauchy_sums_sse,
-    residuals_sse};
+    "sse", blur3_sse, home__refine_downsample_sse, select_keys_sse, home__refine_warp_sse,
+    home__refine_accumulate_sse, home__refine_cauchy_sums_sse, home__refine_residuals_sse};
 #else
 typedef int home__refine_sse_unused; /* ISO C forbids an empty translation unit */
 #endif

@@ -423,7 +423,7 @@ void test_kernels_match_references(void)
  * pointers, points leaving the image, extreme grey levels. */
 void test_kernels_backends_identical(void)
 {
-    static const int simds[2] = {HOME_SIMD_SSE, HOME_SIMD_NEON};
+    static const int simds[3] = {HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
     const home__refine_kernels *ref = home__refine_kernels_for(HOME_SIMD_NONE);
     static uint8_t src[101 * 67 + 64], d_ref[101 * 67], d_simd[101 * 67];
     static int16_t t_ref[128], t_simd[128], k_ref[128], k_simd[128];
@@ -447,7 +447,7 @@ void test_kernels_backends_identical(void)
     }
     m[0] = 1.01f; m[1] = 0.02f; m[2] = 0.7f; m[3] = -0.015f; m[4] = 0.99f; m[5] = -1.3f;
     m[6] = 1e-4f; m[7] = -2e-4f; m[8] = 1.0f;
-    for (s = 0; s < 2; s++) {
+    for (s = 0; s < 3; s++) {
         const home__refine_kernels *k = home__refine_kernels_for(simds[s]);
         if (!k) continue;
         tested++;
