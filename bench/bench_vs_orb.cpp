@@ -142,10 +142,14 @@ static int count_frames(const char *method, int n, int downscale, int window, fl
     if (home_init(&ctx, &cfg, arena, bytes, NULL) != HOME_OK) return 1;
     static home_features fa, fb;
     home_result res;
+    // a video alternating between the two frames: each step extracts one new frame and
+    // registers it against the previous one, whose refinement snapshot the context still holds
     home_extract(ctx, a.data(), w, &fa);
     for (int i = 0; i < n; i++) {
-        home_extract(ctx, b.data(), w, &fb);
-        home_match(ctx, &fa, &fb, &res);
+        home_features *prev = i % 2 ? &fb : &fa, *cur = i % 2 ? &fa : &fb;
+        home_extract(ctx, (i % 2 ? a : b).data(), w, cur);
+        home_match(ctx, prev, cur, &res);
+        if (res.refine_status != HOME_REFINE_ACCEPTED) fprintf(stderr, "frame %d not refined\n", i);
     }
     return 0;
 }
