@@ -48,8 +48,9 @@ static void usage(FILE *f)
         "  --refine-iterations N  Gauss-Newton iteration cap per level (default 10)\n"
         "  --refine-trust PX    largest corner motion the refinement may make, in Hough-image\n"
         "                       px (default 6)\n"
-        "  --repeat N           register N times; ms are medians, plus \"frame\": B against A's\n"
-        "                       cached features (the video case)\n"
+        "  --repeat N           register N times; ms are medians, plus \"frame\": one new frame\n"
+        "                       registered against the previous one's cached features (the\n"
+        "                       video case: B, A, B, ... alternately)\n"
         "  --save-hough F.pgm   write A's quantised Hough image (rows theta, columns r) with\n"
         "                       its keypoints marked (white: J > 0, black: J < 0)\n"
         "  --help               this text\n",
@@ -233,14 +234,17 @@ int main(int argc, char **argv)
     }
     for (s = 0; s < HOME_STAGE_COUNT; s++) ms[s] = median(samples + (size_t)s * repeat, repeat);
     if (repeat > 1) {
-        /* the video case: A's features cached, each frame extracts B and registers it */
+        /* the video case: a clip alternating B, A, B, ...: each step extracts the new frame
+         * and registers it against the previous one, whose features and refinement snapshot
+         * are cached (registering against a frame two steps back would find no snapshot) */
         static home_features fa, fb;
         home_result fr;
         home_extract(ctx, pa, wa, &fa);
         for (i = 0; i < repeat; i++) {
+            const int odd = i % 2;
             double t0 = clock_ms(NULL);
-            home_extract(ctx, pb, wb, &fb);
-            home_match(ctx, &fa, &fb, &fr);
+            home_extract(ctx, odd ? pa : pb, odd ? wa : wb, odd ? &fa : &fb);
+            home_match(ctx, odd ? &fb : &fa, odd ? &fa : &fb, &fr);
             samples[i] = clock_ms(NULL) - t0;
         }
         frame_ms = median(samples, repeat);
