@@ -25,18 +25,16 @@ static void blur3_avx2(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
     const __m256i eight = _mm256_set1_epi16(8);
     int x, y;
     for (y = 0; y < h; y++) {
-        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
-        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
-        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
+        const uint8_t *a, *b, *c;
         uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        home__blur3_rows(src, src_stride, y, h, &a, &b, &c);
         for (x = 0; x + 16 <= w; x += 16) {
             __m256i vb = load16_u16(b + x);
             __m256i s = _mm256_add_epi16(_mm256_add_epi16(load16_u16(a + x), load16_u16(c + x)),
                                          _mm256_add_epi16(vb, vb));
             _mm256_storeu_si256((__m256i *)(void *)(tmp + x), s);
         }
-        for (; x < w; x++) tmp[x] = (int16_t)(a[x] + 2 * b[x] + c[x]);
-        d[0] = (uint8_t)((3 * tmp[0] + tmp[1] + 8) >> 4);
+        home__blur3_vertical(a, b, c, tmp, x, w);
         for (x = 1; x + 16 <= w - 1; x += 16) {
             __m256i l = _mm256_loadu_si256((const __m256i *)(const void *)(tmp + x - 1));
             __m256i m = _mm256_loadu_si256((const __m256i *)(const void *)(tmp + x));
@@ -44,8 +42,7 @@ static void blur3_avx2(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
             __m256i s = _mm256_add_epi16(_mm256_add_epi16(l, r), _mm256_add_epi16(m, m));
             store16_u8(d + x, _mm256_srli_epi16(_mm256_add_epi16(s, eight), 4));
         }
-        for (; x < w - 1; x++) d[x] = (uint8_t)((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
-        d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
+        home__blur3_horizontal(tmp, d, x, w);
     }
 }
 
@@ -72,11 +69,7 @@ static void select_keys_avx2(const uint8_t *row, ptrdiff_t stride, int w, int b,
         if (accumulate) key = _mm256_max_epi16(key, _mm256_loadu_si256(dst));
         _mm256_storeu_si256(dst, key);
     }
-    for (; x < w - 1; x++) {
-        int gx = row[x + 1] - row[x - 1], gy = row[x + stride] - row[x - stride];
-        int key = ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)) << 4 | (dy * b + (x & (b - 1)));
-        if (!accumulate || key > keys[x]) keys[x] = (int16_t)key;
-    }
+    home__select_keys_px(row, stride, x, w, b, dy, keys, accumulate);
 }
 
 const home__refine_kernels home__refine_kernels_avx2 = {

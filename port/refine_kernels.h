@@ -51,6 +51,48 @@ typedef struct home__refine_kernels {
                       float beta, float *res);
 } home__refine_kernels;
 
+/* The reference's per-pixel arithmetic of blur3 and select_keys, written once: the scalar
+ * kernels are these over whole rows, the SIMD kernels over the pixels their vectors leave. */
+
+/* the rows above and below row y, replicated at the image's top and bottom */
+static inline void home__blur3_rows(const uint8_t *src, ptrdiff_t stride, int y, int h,
+                                    const uint8_t **a, const uint8_t **b, const uint8_t **c)
+{
+    *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * stride;
+    *b = src + (ptrdiff_t)y * stride;
+    *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * stride;
+}
+
+/* vertical [1 2 1]: tmp[x] for x in [x0, w) */
+static inline void home__blur3_vertical(const uint8_t *a, const uint8_t *b, const uint8_t *c,
+                                        int16_t *tmp, int x0, int w)
+{
+    int x;
+    for (x = x0; x < w; x++) tmp[x] = (int16_t)(a[x] + 2 * b[x] + c[x]);
+}
+
+/* horizontal [1 2 1] and the one rounding: d[x] for x in [x0, w - 1), and both edge pixels
+ * (replicated neighbour) */
+static inline void home__blur3_horizontal(const int16_t *tmp, uint8_t *d, int x0, int w)
+{
+    int x;
+    for (x = x0; x < w - 1; x++) d[x] = (uint8_t)((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
+    d[0] = (uint8_t)((3 * tmp[0] + tmp[1] + 8) >> 4);
+    d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
+}
+
+/* selection keys for x in [x0, w - 1) (see select_keys) */
+static inline void home__select_keys_px(const uint8_t *row, ptrdiff_t stride, int x0, int w, int b,
+                                        int dy, int16_t *keys, int accumulate)
+{
+    int x;
+    for (x = x0; x < w - 1; x++) {
+        int gx = row[x + 1] - row[x - 1], gy = row[x + stride] - row[x - stride];
+        int key = ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)) << 4 | (dy * b + (x & (b - 1)));
+        if (!accumulate || key > keys[x]) keys[x] = (int16_t)key;
+    }
+}
+
 extern const home__refine_kernels home__refine_kernels_scalar;
 #if defined(__SSE2__)
 extern const home__refine_kernels home__refine_kernels_sse;

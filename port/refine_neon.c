@@ -10,17 +10,15 @@ static void blur3_neon(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
 {
     int x, y;
     for (y = 0; y < h; y++) {
-        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
-        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
-        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
+        const uint8_t *a, *b, *c;
         uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        home__blur3_rows(src, src_stride, y, h, &a, &b, &c);
         for (x = 0; x + 8 <= w; x += 8) {
             uint16x8_t vb = vmovl_u8(vld1_u8(b + x));
             uint16x8_t s = vaddq_u16(vaddl_u8(vld1_u8(a + x), vld1_u8(c + x)), vaddq_u16(vb, vb));
             vst1q_s16(tmp + x, vreinterpretq_s16_u16(s));
         }
-        for (; x < w; x++) tmp[x] = (int16_t)(a[x] + 2 * b[x] + c[x]);
-        d[0] = (uint8_t)((3 * tmp[0] + tmp[1] + 8) >> 4);
+        home__blur3_vertical(a, b, c, tmp, x, w);
         for (x = 1; x + 8 <= w - 1; x += 8) {
             uint16x8_t l = vreinterpretq_u16_s16(vld1q_s16(tmp + x - 1));
             uint16x8_t m = vreinterpretq_u16_s16(vld1q_s16(tmp + x));
@@ -28,8 +26,7 @@ static void blur3_neon(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
             uint16x8_t s = vaddq_u16(vaddq_u16(l, r), vaddq_u16(m, m));
             vst1_u8(d + x, vmovn_u16(vshrq_n_u16(vaddq_u16(s, vdupq_n_u16(8)), 4)));
         }
-        for (; x < w - 1; x++) d[x] = (uint8_t)((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
-        d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
+        home__blur3_horizontal(tmp, d, x, w);
     }
 }
 
@@ -65,11 +62,7 @@ static void select_keys_neon(const uint8_t *row, ptrdiff_t stride, int w, int b,
         if (accumulate) key = vmaxq_s16(key, vld1q_s16(keys + x));
         vst1q_s16(keys + x, key);
     }
-    for (; x < w - 1; x++) {
-        int gx = row[x + 1] - row[x - 1], gy = row[x + stride] - row[x - stride];
-        int key = ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)) << 4 | (dy * b + (x & (b - 1)));
-        if (!accumulate || key > keys[x]) keys[x] = (int16_t)key;
-    }
+    home__select_keys_px(row, stride, x, w, b, dy, keys, accumulate);
 }
 
 static float32x4_t load4_s16(const int16_t *p)

@@ -5,16 +5,13 @@
 static void blur3_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
                          ptrdiff_t dst_stride, int w, int h, int16_t *tmp)
 {
-    int x, y;
+    int y;
     for (y = 0; y < h; y++) {
-        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
-        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
-        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
+        const uint8_t *a, *b, *c;
         uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
-        for (x = 0; x < w; x++) tmp[x] = (int16_t)(a[x] + 2 * b[x] + c[x]);
-        d[0] = (uint8_t)((3 * tmp[0] + tmp[1] + 8) >> 4);
-        for (x = 1; x < w - 1; x++) d[x] = (uint8_t)((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
-        d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
+        home__blur3_rows(src, src_stride, y, h, &a, &b, &c);
+        home__blur3_vertical(a, b, c, tmp, 0, w);
+        home__blur3_horizontal(tmp, d, 1, w);
     }
 }
 
@@ -33,13 +30,8 @@ static void downsample_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t 
 static void select_keys_scalar(const uint8_t *row, ptrdiff_t stride, int w, int b, int dy,
                                int16_t *keys, int accumulate)
 {
-    int x;
     if (!accumulate) keys[0] = keys[w - 1] = 0;
-    for (x = 1; x < w - 1; x++) {
-        int gx = row[x + 1] - row[x - 1], gy = row[x + stride] - row[x - stride];
-        int key = ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)) << 4 | (dy * b + (x & (b - 1)));
-        if (!accumulate || key > keys[x]) keys[x] = (int16_t)key;
-    }
+    home__select_keys_px(row, stride, 1, w, b, dy, keys, accumulate);
 }
 
 static void warp_scalar(const float *m, const int16_t *xs, const int16_t *ys, int n,

@@ -15,17 +15,15 @@ static void blur3_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst, pt
     const __m128i eight = _mm_set1_epi16(8);
     int x, y;
     for (y = 0; y < h; y++) {
-        const uint8_t *a = src + (ptrdiff_t)(y > 0 ? y - 1 : 0) * src_stride;
-        const uint8_t *b = src + (ptrdiff_t)y * src_stride;
-        const uint8_t *c = src + (ptrdiff_t)(y < h - 1 ? y + 1 : h - 1) * src_stride;
+        const uint8_t *a, *b, *c;
         uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        home__blur3_rows(src, src_stride, y, h, &a, &b, &c);
         for (x = 0; x + 8 <= w; x += 8) {
             __m128i vb = load8_u16(b + x);
             __m128i s = _mm_add_epi16(_mm_add_epi16(load8_u16(a + x), load8_u16(c + x)), _mm_add_epi16(vb, vb));
             _mm_storeu_si128((__m128i *)(void *)(tmp + x), s);
         }
-        for (; x < w; x++) tmp[x] = (int16_t)(a[x] + 2 * b[x] + c[x]);
-        d[0] = (uint8_t)((3 * tmp[0] + tmp[1] + 8) >> 4);
+        home__blur3_vertical(a, b, c, tmp, x, w);
         for (x = 1; x + 8 <= w - 1; x += 8) {
             __m128i l = _mm_loadu_si128((const __m128i *)(const void *)(tmp + x - 1));
             __m128i m = _mm_loadu_si128((const __m128i *)(const void *)(tmp + x));
@@ -34,8 +32,7 @@ static void blur3_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst, pt
             s = _mm_srli_epi16(_mm_add_epi16(s, eight), 4);
             _mm_storel_epi64((__m128i *)(void *)(d + x), _mm_packus_epi16(s, s));
         }
-        for (; x < w - 1; x++) d[x] = (uint8_t)((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
-        d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
+        home__blur3_horizontal(tmp, d, x, w);
     }
 }
 
@@ -83,11 +80,7 @@ static void select_keys_sse(const uint8_t *row, ptrdiff_t stride, int w, int b, 
         if (accumulate) key = _mm_max_epi16(key, _mm_loadu_si128(dst));
         _mm_storeu_si128(dst, key);
     }
-    for (; x < w - 1; x++) {
-        int gx = row[x + 1] - row[x - 1], gy = row[x + stride] - row[x - stride];
-        int key = ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)) << 4 | (dy * b + (x & (b - 1)));
-        if (!accumulate || key > keys[x]) keys[x] = (int16_t)key;
-    }
+    home__select_keys_px(row, stride, x, w, b, dy, keys, accumulate);
 }
 
 static __m128 load4_s16(const int16_t *p)
