@@ -32,6 +32,7 @@ static void usage(FILE *f)
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
             "                    its 1/2 or 1/4 size copy (2, 4; default: the one about 160 px wide)\n"
+            "  --theta-bins N    HOME's theta bins (16..%d; default 120)\n"
             "  --side-by-side    write original | stabilised, twice as wide\n"
             "  --csv FILE        per frame: raw and smoothed camera path (tx, ty px, angle rad,\n"
             "                    log scale), share of the correction applied, and the warp\n"
@@ -39,7 +40,7 @@ static void usage(FILE *f)
             "  --plot FILE.png   plot of the raw and smoothed path\n"
             "  --quiet           no progress on stderr\n"
             "Exit: 0 ok; 1 input ended with a malformed or truncated frame (the frames before it\n"
-            "are written); 2 bad usage or unreadable input.\n");
+            "are written); 2 bad usage or unreadable input.\n", HOME_MAX_THETA_BINS);
 }
 
 static int number(const char *s, double lo, double hi, double *out)
@@ -121,7 +122,8 @@ int main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
     home_stab_config cfg;
-    double margin = 0.10, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0;
+    double margin = 0.10, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0,
+           theta_bins = 0;
     double t_start, ms_reg = 0, ms_warp = 0, last_report;
     app ap;
     home_stab *stab = NULL;
@@ -155,6 +157,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--lookahead")) { target = &lookahead; lo = 0; hi = HOME_STAB_MAX_LOOKAHEAD; }
         else if (!strcmp(a, "--downscale")) { target = &downscale; lo = 1; hi = 4; }
         else if (!strcmp(a, "--hough-downscale")) { target = &hough_ds; lo = 1; hi = 4; }
+        else if (!strcmp(a, "--theta-bins")) { target = &theta_bins; lo = 16; hi = HOME_MAX_THETA_BINS; }
         else if (!strcmp(a, "--keypoints")) { target = &keypoints; lo = 16; hi = HOME_MAX_KEYPOINTS_PER_SIGN; }
         else { fprintf(stderr, "home-stab: unknown option %s (see --help)\n", a); return 2; }
         if (number(argv[++i], lo, hi, target)) {
@@ -177,6 +180,7 @@ int main(int argc, char **argv)
     cfg.keypoints_per_sign = (int)keypoints;
     cfg.refine = refine;
     if (hough_ds > 0) cfg.hough_downscale = (int)hough_ds;
+    cfg.theta_bins = (int)theta_bins;
     cfg.clock = now_ms;
     if (status == HOME_OK) status = home_stab_validate_config(&cfg);
     if (status != HOME_OK) {

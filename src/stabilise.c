@@ -10,7 +10,7 @@
 #define STAB_INIT_VEL_VAR 1.0             /* prior variance of the path velocity, (px/frame)^2 */
 #define STAB_FIT_GRID 5                   /* similarity fitted to H on a 5x5 grid of the frame */
 #define STAB_BISECT_STEPS 30
-#define STAB_THETA_BINS 120               /* HOME's theta bins for video registration */
+#define STAB_THETA_BINS 120               /* HOME's automatic theta bins for video registration */
 
 /* One frame of path history. Path components are normalised to pixels (angle and log scale
  * times the half diagonal) so that one filter covariance serves all four of them. */
@@ -81,7 +81,7 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
 /* The HOME configuration registration runs with. */
 static int home_config_for(const home_stab_config *cfg, home_config *h)
 {
-    int f = cfg->downscale, status;
+    int f = cfg->downscale, status, bins;
     if (f != 1 && f != 2 && f != 4) return HOME_E_CONFIG;
     status = home_video_config(h, cfg->width / f, cfg->height / f);
     if (status != HOME_OK) return status;
@@ -93,8 +93,10 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
     /* half the video defaults' theta bins: on the bench clips (also with 10 px / 1 degree
      * shake) the same jitter to 0.001 px, the Hough transform at half the cost, and at least
      * 90 inliers per frame (min_inliers 20); the refinement gives the precision */
-    h->wrap_band = h->wrap_band * STAB_THETA_BINS / h->theta_bins;
-    h->theta_bins = STAB_THETA_BINS;
+    bins = cfg->theta_bins ? cfg->theta_bins : STAB_THETA_BINS;
+    if (bins < 16 || bins > HOME_MAX_THETA_BINS) return HOME_E_CONFIG;
+    h->wrap_band = h->wrap_band * bins / h->theta_bins;
+    h->theta_bins = bins;
     /* video motion prior: lines rotate by at most max_rotation between frames (+2 bins) */
     h->match_theta_window = (int)ceil(cfg->max_rotation * h->theta_bins / 3.14159265358979) + 2;
     if (h->match_theta_window > h->theta_bins) h->match_theta_window = h->theta_bins;

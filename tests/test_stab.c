@@ -22,13 +22,14 @@ static union { unsigned char bytes[8u << 20]; double align; } arena;
 static uint8_t clip[CLIP_FRAMES][CW * CH * 3 / 2];
 static double clip_g[CLIP_FRAMES][9];
 
-static home_stab *make_stab(int lookahead, int downscale)
+static home_stab *make_stab(int lookahead, int downscale, int theta_bins)
 {
     home_stab_config cfg;
     home_stab *st = NULL;
     home_stab_default_config(&cfg, CW, CH);
     cfg.lookahead = lookahead;
     cfg.downscale = downscale;
+    cfg.theta_bins = theta_bins;
     if (home_stab_init(&st, &cfg, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL) != HOME_OK) return NULL;
     return st;
 }
@@ -80,10 +81,10 @@ typedef struct run_result {
 } run_result;
 
 /* Stabilise the clip (frames flat_from..flat_to replaced by flat grey when flat_to >= 0). */
-static void run_clip(int lookahead, int downscale, int flat_from, int flat_to, run_result *r)
+static void run_clip(int lookahead, int downscale, int theta_bins, int flat_from, int flat_to, run_result *r)
 {
     static uint8_t flat[CW * CH * 3 / 2];
-    home_stab *st = make_stab(lookahead, downscale);
+    home_stab *st = make_stab(lookahead, downscale, theta_bins);
     home_stab_output o;
     home_stab_image im;
     int t;
@@ -143,7 +144,7 @@ static void test_jitter_reduced_causal(void)
     static run_result r;
     double in = input_jitter(), out;
     int t, ok = 0;
-    run_clip(0, 1, 0, -1, &r);
+    run_clip(0, 1, 0, 0, -1, &r);
     out = output_jitter(&r);
     for (t = 1; t < CLIP_FRAMES; t++) ok += r.status[t] == HOME_STAB_MOTION_OK;
     printf("    jitter in %.3f px, out %.3f px (causal), %d/%d registered\n", in, out, ok, CLIP_FRAMES - 1);
@@ -159,8 +160,8 @@ static void test_lookahead_latency_and_gain(void)
 {
     static run_result causal, ahead;
     double j0, j1;
-    run_clip(0, 1, 0, -1, &causal);
-    run_clip(12, 1, 0, -1, &ahead);
+    run_clip(0, 1, 0, 0, -1, &causal);
+    run_clip(12, 1, 0, 0, -1, &ahead);
     j0 = output_jitter(&causal);
     j1 = output_jitter(&ahead);
     printf("    jitter causal %.3f px, lookahead 12: %.3f px\n", j0, j1);
@@ -174,10 +175,25 @@ static void test_downscaled_registration(void)
 {
     static run_result r;
     double in = input_jitter(), out;
-    run_clip(0, 2, 0, -1, &r);
+    run_clip(0, 2, 0, 0, -1, &r);
     out = output_jitter(&r);
     printf("    jitter with registration at 1/2 size: %.3f px\n", out);
     CHECK_LT(out, 0.5 * in);
+    CHECK(r.inside);
+}
+
+/* Fewer theta bins than the automatic 120 (cheaper Hough transform) still stabilise. */
+static void test_fewer_theta_bins(void)
+{
+    static run_result r;
+    double in = input_jitter(), out;
+    int t, ok = 0;
+    run_clip(0, 1, 48, 0, -1, &r);
+    out = output_jitter(&r);
+    for (t = 1; t < CLIP_FRAMES; t++) ok += r.status[t] == HOME_STAB_MOTION_OK;
+    printf("    jitter with 48 theta bins: %.3f px, %d/%d registered\n", out, ok, CLIP_FRAMES - 1);
+    CHECK_LT(out, 0.35 * in);
+    CHECK(ok >= CLIP_FRAMES - 3);
     CHECK(r.inside);
 }
 
@@ -188,7 +204,7 @@ static void test_hold_on_failure(void)
     static run_result r;
     double max_step = 0;
     int t, held = 0;
-    run_clip(0, 1, 30, 37, &r);
+    run_clip(0, 1, 0, 30, 37, &r);
     for (t = 30; t <= 38; t++) held += r.status[t] == HOME_STAB_MOTION_FAILED || r.status[t] == HOME_STAB_MOTION_IMPLAUSIBLE;
     for (t = 1; t < CLIP_FRAMES; t++) {
         double step = hypot(r.warp[t][2] - r.warp[t - 1][2], r.warp[t][5] - r.warp[t - 1][5]);
@@ -206,7 +222,7 @@ static void test_hold_on_failure(void)
 static void test_implausible_jump_held(void)
 {
     static uint8_t jumped[CW * CH * 3 / 2];
-    home_stab *st = make_stab(0, 1);
+    home_stab *st = make_stab(0, 1, 0);
     home_stab_output o;
     home_stab_image im;
     double g[9], max_step = 0, prev_x = 0, prev_y = 0;
@@ -240,8 +256,8 @@ static void test_implausible_jump_held(void)
 static void test_deterministic(void)
 {
     static run_result a, b;
-    run_clip(4, 1, 0, -1, &a);
-    run_clip(4, 1, 0, -1, &b);
+    run_clip(4, 1, 0, 0, -1, &a);
+    run_clip(4, 1, 0, 0, -1, &b);
     CHECK(memcmp(a.warp, b.warp, sizeof a.warp) == 0);
 }
 
@@ -472,7 +488,7 @@ static void test_api_contract(void)
 #define STAB_TESTS(X) \
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
     X(warp_formats_agree) X(warp_backends_identical) X(jitter_reduced_causal) X(lookahead_latency_and_gain) \
-    X(downscaled_registration) X(hold_on_failure) X(implausible_jump_held) X(deterministic)
+    X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(deterministic)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
 

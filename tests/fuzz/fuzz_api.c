@@ -67,7 +67,7 @@ static double fake_clock(void *user)
 }
 
 /* Fill a width x height image: tiled raw bytes, or shapes (rectangles and bars) on a ramp. */
-static void fill_image(fz_reader *r, uint8_t *img, int width, int height, ptrdiff_t stride)
+FZ_NO_COVERAGE static void fill_image(fz_reader *r, uint8_t *img, int width, int height, ptrdiff_t stride)
 {
     int recipe = (int)(fz_u8(r) % 3), x, y;
     if (recipe == 0) {
@@ -93,7 +93,7 @@ static void fill_image(fz_reader *r, uint8_t *img, int width, int height, ptrdif
 }
 
 /* b = a shifted by (dx, dy) with edge replication, plus sparse fuzzed perturbations. */
-static void shifted_copy(fz_reader *r, const uint8_t *a, uint8_t *b, int width, int height,
+FZ_NO_COVERAGE static void shifted_copy(fz_reader *r, const uint8_t *a, uint8_t *b, int width, int height,
                          ptrdiff_t sa, ptrdiff_t sb)
 {
     int dx = fz_range(r, -6, 6), dy = fz_range(r, -6, 6), x, y, k, n = fz_range(r, 0, 8);

@@ -6,14 +6,16 @@
 #include "home_stab.h"
 #include <math.h>
 
-/* Every pushed frame costs a Hough transform at HOME's 480 theta bins, so executions are kept
- * short (issue 7): unless all three FLAG_LARGE bits are set (one random input in eight), frames
- * are 32..36 px, 8..24 keypoints per sign and 0..2 frames are pushed (none: the config, arena,
- * frame and warper checks alone); large inputs use 32..64 px, 8..150 keypoints, 1..5 frames. */
+/* Every pushed frame costs a Hough transform, so executions are kept short (issue 7): unless all
+ * three FLAG_LARGE bits are set (one random input in eight), frames are 32..36 px, 16..24 theta
+ * bins, 8..24 keypoints per sign and 0..2 frames are pushed (none: the config, arena, frame and
+ * warper checks alone); large inputs use 32..64 px, 16..120 theta bins or the automatic 120,
+ * 8..150 keypoints, 1..5 frames. */
 #define FZ_SIDE_MAX 64
 #define FZ_TINY_SIDE 36
 #define FZ_TINY_KEYPOINTS 24
 #define FZ_TINY_FRAMES 2
+#define FZ_TINY_THETA_BINS 24
 #define FZ_FRAMES_MAX 5
 #define FLAG_LARGE (7u << 13)
 #define FZ_PLANE_BYTES (2 * (FZ_SIDE_MAX + 8) * FZ_SIDE_MAX)
@@ -45,7 +47,7 @@ static int plane_count(int fmt)
 
 /* Frame k: the base scene shifted by (k*dx, k*dy); planes end where their buffers end. Returns
  * 1 when the frame is well formed. */
-static int make_frame(fz_reader *r, home_stab_image *im, int k, int fmt, int w, int h, int pad,
+FZ_NO_COVERAGE static int make_frame(fz_reader *r, home_stab_image *im, int k, int fmt, int w, int h, int pad,
                       const uint8_t *scene, int dx, int dy)
 {
     int p, x, y, valid = fmt >= HOME_STAB_I420 && fmt <= HOME_STAB_GREY;
@@ -98,12 +100,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     s = home_stab_default_config(&cfg, w, h);
     FZ_CHECK(is_status(s));
     cfg.keypoints_per_sign = fz_range(r, 8, large ? 150 : FZ_TINY_KEYPOINTS);
+    cfg.theta_bins = !large ? fz_range(r, 16, FZ_TINY_THETA_BINS) : (fz_u8(r) & 1) ? 0 : fz_range(r, 16, 120);
     cfg.lookahead = fz_range(r, 0, 3);
     cfg.downscale = 1;
     if (flags & 2) {
         float f = fz_float_bits(r);
         int32_t raw = (int32_t)fz_u32(r);
-        switch (fz_u8(r) % 10) {
+        switch (fz_u8(r) % 11) {
         case 0: cfg.margin = f; break;
         case 1: cfg.smoothing = f; break;
         case 2: cfg.lookahead = raw % 256; break;
@@ -113,6 +116,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         case 6: cfg.max_shift = f; break;
         case 7: cfg.max_rotation = f; break;
         case 8: cfg.max_zoom = f; break;
+        case 9: cfg.theta_bins = raw % 4096; break;
         default: cfg.max_residual = f; break;
         }
     }
