@@ -35,10 +35,11 @@ typedef struct home__refine_kernels {
      * acc[k * 4 + lane], k < 36 the upper triangle of sum w sd sd^T, k = 36 + j sum w r sd_j,
      * sd = (gx u, gx v, gx, gy u, gy v, gy, -(u g), -(v g)), g = gx u + gy v,
      * u = aff[0] x + aff[1], v = aff[0] y + aff[2]; ws = w sd_p then += ws sd_q; wr = w r then
-     * += sd_j wr. n is a multiple of 4. */
+     * += sd_j wr. n is a multiple of 4. hessian == 0: only the J^T W r entries (k >= 36) are
+     * written, the rest of acc is left as it is (the solver reuses a level's first Hessian). */
     void (*accumulate)(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
                        const int16_t *gys, const float *r, const float *w, int n,
-                       const float *aff, float *acc);
+                       const float *aff, int hessian, float *acc);
     /* Cauchy weights of the gain/bias fit, per lane (point i is lane i % 4): point i counts when
      * i < n_valid, b[i] >= 0 and keep[i] >= 0; then with bi = b[i] (else bi = 0),
      * q = (alpha bi + beta - t[i]) inv_c, w = 1 / (1 + q q) (else w = 0), wt[i] = w and
@@ -103,7 +104,7 @@ void home__refine_warp_sse(const float *m, const int16_t *xs, const int16_t *ys,
                            const uint8_t *img, ptrdiff_t stride, int w, int h, float *out);
 void home__refine_accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
                                  const int16_t *gys, const float *r, const float *w, int n,
-                                 const float *aff, float *acc);
+                                 const float *aff, int hessian, float *acc);
 int home__refine_cauchy_sums_sse(const float *b, const float *keep, const int16_t *t, int n,
                                  int n_valid, float alpha, float beta, float inv_c, float *wt,
                                  float *part);

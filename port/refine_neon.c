@@ -127,7 +127,7 @@ static void warp_neon(const float *m, const int16_t *xs, const int16_t *ys, int 
 
 static void accumulate_neon(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
                             const int16_t *gys, const float *r, const float *w, int n,
-                            const float *aff, float *acc)
+                            const float *aff, int hessian, float *acc)
 {
     const float32x4_t a = vdupq_n_f32(aff[0]), bu = vdupq_n_f32(aff[1]), bv = vdupq_n_f32(aff[2]);
     float32x4_t sum[HOME__REFINE_ACC];
@@ -143,13 +143,14 @@ static void accumulate_neon(const int16_t *xs, const int16_t *ys, const int16_t 
         sd[0] = vmulq_f32(gx, u); sd[1] = vmulq_f32(gx, v); sd[2] = gx;
         sd[3] = vmulq_f32(gy, u); sd[4] = vmulq_f32(gy, v); sd[5] = gy;
         sd[6] = vnegq_f32(vmulq_f32(u, g)); sd[7] = vnegq_f32(vmulq_f32(v, g));
+        for (p = 0; p < 8; p++) sum[36 + p] = vaddq_f32(sum[36 + p], vmulq_f32(sd[p], wr));
+        if (!hessian) continue;
         for (p = 0, k = 0; p < 8; p++) {
             float32x4_t ws = vmulq_f32(wi, sd[p]);
             for (q = p; q < 8; q++, k++) sum[k] = vaddq_f32(sum[k], vmulq_f32(ws, sd[q]));
-            sum[36 + p] = vaddq_f32(sum[36 + p], vmulq_f32(sd[p], wr));
         }
     }
-    for (k = 0; k < HOME__REFINE_ACC; k++) vst1q_f32(acc + k * HOME__REFINE_LANES, sum[k]);
+    for (k = hessian ? 0 : 36; k < HOME__REFINE_ACC; k++) vst1q_f32(acc + k * HOME__REFINE_LANES, sum[k]);
 }
 
 static int cauchy_sums_neon(const float *b, const float *keep, const int16_t *t, int n,

@@ -60,10 +60,11 @@ static void warp_scalar(const float *m, const int16_t *xs, const int16_t *ys, in
 
 static void accumulate_scalar(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
                               const int16_t *gys, const float *r, const float *w, int n,
-                              const float *aff, float *acc)
+                              const float *aff, int hessian, float *acc)
 {
     int i, p, q, k;
-    memset(acc, 0, HOME__REFINE_ACC * HOME__REFINE_LANES * sizeof *acc);
+    if (hessian) memset(acc, 0, HOME__REFINE_ACC * HOME__REFINE_LANES * sizeof *acc);
+    else memset(acc + 36 * HOME__REFINE_LANES, 0, 8 * HOME__REFINE_LANES * sizeof *acc);
     for (i = 0; i < n; i++) {
         const int lane = i & (HOME__REFINE_LANES - 1);
         float u = aff[0] * (float)xs[i] + aff[1], v = aff[0] * (float)ys[i] + aff[2];
@@ -75,7 +76,8 @@ static void accumulate_scalar(const int16_t *xs, const int16_t *ys, const int16_
         sd[6] = -(u * g); sd[7] = -(v * g);
         for (p = 0, k = 0; p < 8; p++) {
             float ws = w[i] * sd[p];
-            for (q = p; q < 8; q++, k++) acc[k * HOME__REFINE_LANES + lane] += ws * sd[q];
+            if (hessian)
+                for (q = p; q < 8; q++, k++) acc[k * HOME__REFINE_LANES + lane] += ws * sd[q];
             acc[(36 + p) * HOME__REFINE_LANES + lane] += sd[p] * wr;
         }
     }

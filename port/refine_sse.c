@@ -139,7 +139,7 @@ void home__refine_warp_sse(const float *m, const int16_t *xs, const int16_t *ys,
 
 void home__refine_accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
                                  const int16_t *gys, const float *r, const float *w, int n,
-                                 const float *aff, float *acc)
+                                 const float *aff, int hessian, float *acc)
 {
     const __m128 a = _mm_set1_ps(aff[0]), bu = _mm_set1_ps(aff[1]), bv = _mm_set1_ps(aff[2]);
     const __m128 sign = _mm_set1_ps(-0.0f);
@@ -156,13 +156,14 @@ void home__refine_accumulate_sse(const int16_t *xs, const int16_t *ys, const int
         sd[0] = _mm_mul_ps(gx, u); sd[1] = _mm_mul_ps(gx, v); sd[2] = gx;
         sd[3] = _mm_mul_ps(gy, u); sd[4] = _mm_mul_ps(gy, v); sd[5] = gy;
         sd[6] = _mm_xor_ps(_mm_mul_ps(u, g), sign); sd[7] = _mm_xor_ps(_mm_mul_ps(v, g), sign);
+        for (p = 0; p < 8; p++) sum[36 + p] = _mm_add_ps(sum[36 + p], _mm_mul_ps(sd[p], wr));
+        if (!hessian) continue;
         for (p = 0, k = 0; p < 8; p++) {
             __m128 ws = _mm_mul_ps(wi, sd[p]);
             for (q = p; q < 8; q++, k++) sum[k] = _mm_add_ps(sum[k], _mm_mul_ps(ws, sd[q]));
-            sum[36 + p] = _mm_add_ps(sum[36 + p], _mm_mul_ps(sd[p], wr));
         }
     }
-    for (k = 0; k < HOME__REFINE_ACC; k++) _mm_storeu_ps(acc + k * HOME__REFINE_LANES, sum[k]);
+    for (k = hessian ? 0 : 36; k < HOME__REFINE_ACC; k++) _mm_storeu_ps(acc + k * HOME__REFINE_LANES, sum[k]);
 }
 
 int home__refine_cauchy_sums_sse(const float *b, const float *keep, const int16_t *t, int n,

@@ -375,7 +375,7 @@ void test_kernels_match_references(void)
         bad += out[i] != expect;
     }
     CHECK_EQ_INT(bad, 0);
-    k->accumulate(xs, ys, gx, gy, r, w, 64, aff, acc);
+    k->accumulate(xs, ys, gx, gy, r, w, 64, aff, 1, acc);
     memset(ref, 0, sizeof ref);
     for (i = 0; i < 64; i++) {
         double u = aff[0] * (double)xs[i] + aff[1], v = aff[0] * (double)ys[i] + aff[2], g = gx[i] * u + gy[i] * v;
@@ -393,6 +393,14 @@ void test_kernels_match_references(void)
         bad += fabs(s - ref[j]) > 1e-4 * (fabs(ref[j]) + 1.0);
     }
     CHECK_EQ_INT(bad, 0);
+    /* J^T W r alone (hessian = 0): the same sums, J^T W J left untouched */
+    {
+        static float grad_only[44 * 4];
+        memset(grad_only, 0x7f, sizeof grad_only);
+        k->accumulate(xs, ys, gx, gy, r, w, 64, aff, 0, grad_only);
+        CHECK(memcmp(grad_only + 36 * 4, acc + 36 * 4, 8 * 4 * sizeof *acc) == 0);
+        CHECK(grad_only[0] == grad_only[35 * 4 + 3] && grad_only[0] != acc[0]);
+    }
     /* Cauchy fit sums: points past n_valid or with a negative sample or mask do not count */
     {
         static float wt[64], part[20];
@@ -469,9 +477,14 @@ void test_kernels_backends_identical(void)
             ref->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_ref);
             k->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_simd);
             CHECK(memcmp(o_ref, o_simd, 256 * sizeof *o_ref) == 0);
-            ref->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, a_ref);
-            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, a_simd);
+            ref->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 1, a_ref);
+            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 1, a_simd);
             CHECK(memcmp(a_ref, a_simd, sizeof a_ref) == 0);
+            /* J^T W r alone: the same sums, J^T W J left as it was */
+            memset(a_simd, 0x7f, sizeof a_simd);
+            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 0, a_simd);
+            CHECK(memcmp(a_ref + 36 * 4, a_simd + 36 * 4, 8 * 4 * sizeof *a_ref) == 0);
+            CHECK(a_simd[0] == a_simd[35 * 4 + 3] && a_simd[0] != a_ref[0]);
             /* gain/bias fit: o_ref holds warped samples (some -1), r doubles as the keep mask */
             CHECK_EQ_INT(ref->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_ref, a_ref),
                          k->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_simd, a_simd));
