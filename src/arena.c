@@ -169,7 +169,10 @@ uint32_t home__config_id(const home_config *cfg)
 
 typedef struct layout {
     size_t window_desc, window_theta, window_index;
-    size_t img_n, img_t, shift, row_lo, row_hi, first_row, line_sum, edge_prefix, line_j;
+    size_t img_n, img_t, geom, geom_scratch, line_sum, edge_prefix, line_j;
+    size_t geom_bytes;                /* one record's arrays */
+    int geom_rows, geom_first;        /* raw theta rows cached (0: none) and the first's k */
+    int geom_longest, geom_blocks;
     ptrdiff_t img_n_stride, img_t_stride;
     size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, matches,
         inliers, slots, refine, total;
@@ -183,15 +186,42 @@ static size_t take(size_t *cursor, size_t bytes)
     return at;
 }
 
+/* Bytes of one theta geometry record's arrays, each on a 16-byte boundary. */
+static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
+
+static size_t geom_record_bytes(int longest, int blocks, size_t r_bins)
+{
+    return align16((size_t)longest * sizeof(int16_t)) + 2 * align16((size_t)blocks * sizeof(int16_t)) +
+           align16(((size_t)longest + 4) * sizeof(int32_t)) + align16(r_bins * sizeof(int16_t)) +
+           align16(r_bins * sizeof(float));
+}
+
+/* Point a record's arrays into mem (geom_record_bytes of it). */
+static void carve_geom(home__theta_geom *g, unsigned char *mem, int longest, int blocks, size_t r_bins)
+{
+    g->shift = (int16_t *)(void *)mem;
+    mem += align16((size_t)longest * sizeof(int16_t));
+    g->row_lo = (int16_t *)(void *)mem;
+    mem += align16((size_t)blocks * sizeof(int16_t));
+    g->row_hi = (int16_t *)(void *)mem;
+    mem += align16((size_t)blocks * sizeof(int16_t));
+    g->first_row = (int32_t *)(void *)mem;
+    mem += align16(((size_t)longest + 4) * sizeof(int32_t));
+    g->res_k = (int16_t *)(void *)mem;
+    mem += align16(r_bins * sizeof(int16_t));
+    g->res_f = (float *)(void *)mem;
+}
+
 static void plan(const home_config *cfg, layout *l)
 {
     size_t cur = 0, pixels = (size_t)cfg->width * (size_t)cfg->height;
     size_t r_bins = (size_t)home__r_bins(cfg);
-    size_t radius = (size_t)ceil(3.0 * cfg->smooth_sigma);
+    size_t radius = (size_t)ceil(3.0 * cfg->smooth_sigma); /* as home__gauss_taps() */
     /* every query keypoint, in primary and (near the wrap) alternate form, yields <= 1 match */
     l->max_matches = 4 * cfg->keypoints_per_sign;
     int hough_w, hough_h;
     size_t w, h, longest;
+    if (radius > HOME__MAX_SMOOTH_RADIUS) radius = HOME__MAX_SMOOTH_RADIUS;
     home__hough_size(cfg, &hough_w, &hough_h);
     w = (size_t)hough_w;
     h = (size_t)hough_h;
@@ -199,7 +229,9 @@ static void plan(const home_config *cfg, layout *l)
     /* intercepts of one theta row: the other side + both shear extents + derivative + a block */
     size_t intercepts = w + h + 8 + 2 * HOME__RADON_BLOCK;
     l->ctx = take(&cur, sizeof(home_context));
-    memset(&l->img_n, 0, 9 * sizeof(size_t));
+    l->img_n = l->img_t = l->geom = l->geom_scratch = l->line_sum = l->edge_prefix = l->line_j = 0;
+    l->geom_bytes = 0;
+    l->geom_rows = 0;
     l->grad_x = l->grad_y = 0;
     if (cfg->hough_method == HOME_HOUGH_EXACT) {
         l->grad_x = take(&cur, pixels * sizeof(int16_t));
@@ -209,10 +241,20 @@ static void plan(const home_config *cfg, layout *l)
         l->img_t_stride = (ptrdiff_t)(h + 2 * HOME__RADON_BLOCK);
         l->img_n = take(&cur, h * (size_t)l->img_n_stride);
         l->img_t = take(&cur, w * (size_t)l->img_t_stride);
-        l->shift = take(&cur, longest * sizeof(int16_t));
-        l->row_lo = take(&cur, (intercepts / HOME__RADON_BLOCK + 1) * sizeof(int16_t));
-        l->row_hi = take(&cur, (intercepts / HOME__RADON_BLOCK + 1) * sizeof(int16_t));
-        l->first_row = take(&cur, (longest + 4) * sizeof(int32_t));
+        l->geom_longest = (int)longest;
+        l->geom_blocks = (int)(intercepts / HOME__RADON_BLOCK + 1);
+        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, r_bins);
+        {
+            int rows;
+            home__hough_raw_rows(cfg, (int)radius, &l->geom_first, &rows);
+            size_t bytes = align16((size_t)rows * sizeof(home__theta_geom)) + (size_t)rows * l->geom_bytes;
+            if (bytes <= HOME_HOUGH_GEOMETRY_BYTES) {
+                l->geom_rows = rows;
+                l->geom = take(&cur, bytes);
+            } else {
+                l->geom_scratch = take(&cur, l->geom_bytes);
+            }
+        }
         l->line_sum = take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(int32_t));
         l->edge_prefix = take(&cur, 2 * (longest + 1) * sizeof(int32_t));
         l->line_j = take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(float));
@@ -284,10 +326,21 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
         ctx->img_t = base + l.img_t;
         ctx->img_n_stride = l.img_n_stride;
         ctx->img_t_stride = l.img_t_stride;
-        ctx->shift = (int16_t *)(void *)(base + l.shift);
-        ctx->row_lo = (int16_t *)(void *)(base + l.row_lo);
-        ctx->row_hi = (int16_t *)(void *)(base + l.row_hi);
-        ctx->first_row = (int32_t *)(void *)(base + l.first_row);
+        if (l.geom_rows) {
+            /* records first, then their arrays; every row's geometry computed once, here */
+            unsigned char *arrays = base + l.geom + align16((size_t)l.geom_rows * sizeof(home__theta_geom));
+            int k;
+            ctx->geom = (home__theta_geom *)(void *)(base + l.geom);
+            for (k = 0; k < l.geom_rows; k++) {
+                carve_geom(&ctx->geom[k], arrays + (size_t)k * l.geom_bytes, l.geom_longest,
+                           l.geom_blocks, (size_t)ctx->r_bins);
+                home__theta_geometry(ctx, (l.geom_first + k) * HOME__PI / cfg->theta_bins, &ctx->geom[k]);
+            }
+        } else {
+            ctx->geom = NULL;
+            carve_geom(&ctx->geom_scratch, base + l.geom_scratch, l.geom_longest, l.geom_blocks,
+                       (size_t)ctx->r_bins);
+        }
         ctx->line_sum = (int32_t *)(void *)(base + l.line_sum);
         ctx->edge_prefix = (int32_t *)(void *)(base + l.edge_prefix);
         ctx->line_j = (float *)(void *)(base + l.line_j);

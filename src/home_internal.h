@@ -58,6 +58,21 @@ typedef struct home__refine_state {
     void *scratch;
 } home__refine_state;
 
+/* FAST: what one theta row of the transform needs that depends only on theta and the Hough
+ * image's size (src/hough.c): the shear of every row, the row range of every intercept block,
+ * the intercept -> r resampling. Computed once per context for every theta row when all of them
+ * fit HOME_HOUGH_GEOMETRY_BYTES, else per row and frame into one scratch record. */
+typedef struct home__theta_geom {
+    int vertical, flip;               /* lines within 45 degrees of the columns; rows reversed */
+    int s_min, s_max, j0, n, n_blocks; /* shift range, first intercept, intercepts, blocks */
+    int i_lo, i_hi;                   /* r bins [i_lo, i_hi) fall inside the intercept range */
+    float d_scale, end_scale;         /* J = d_scale (S(j+1) - S(j-1)) + end_scale [I] */
+    int16_t *shift, *row_lo, *row_hi; /* per-row shear, per-block row ranges */
+    int32_t *first_row;               /* first row whose shift reaches a value */
+    int16_t *res_k;                   /* r bin i (from i_lo): intercept index k and weight */
+    float *res_f;                     /*   f of line[k] + f (line[k+1] - line[k]) */
+} home__theta_geom;
+
 struct home_context {
     uint32_t magic;
     home_config cfg;
@@ -75,8 +90,8 @@ struct home_context {
     uint8_t *img_n, *img_t;           /* FAST: the image and its transpose, zero-padded by
                                          HOME__RADON_BLOCK columns on each side */
     ptrdiff_t img_n_stride, img_t_stride;
-    int16_t *shift, *row_lo, *row_hi; /* FAST: per-row shear, per-block row ranges */
-    int32_t *first_row;               /* FAST: first row whose shift reaches a value */
+    home__theta_geom *geom;           /* FAST: every raw theta row's geometry, or NULL */
+    home__theta_geom geom_scratch;    /* FAST: one row's, when not cached */
     int32_t *line_sum;                /* FAST: line sums over the intercept range */
     int32_t *edge_prefix;             /* FAST: prefix sums of the first and last column */
     float *line_j;                    /* FAST: J over the intercept range */
@@ -117,6 +132,11 @@ typedef void (*home__row_fn)(void *user, int row, const float *const *window);
 void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width, int height,
                                 int32_t cos_q, int32_t sin_q, int32_t base_q, int32_t *acc_x,
                                 int32_t *acc_y, int r_bins);
+/* Raw theta rows the stream computes (the theta-smoothing margin and the wrap rows included):
+ * k = first .. first + count - 1, theta = k pi / theta_bins. */
+void home__hough_raw_rows(const home_config *cfg, int radius, int *first, int *count);
+/* Fill a geometry record (its arrays already carved) for theta. */
+void home__theta_geometry(const home_context *ctx, double theta, home__theta_geom *g);
 double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t stride,
                           home__row_fn on_row, void *user);
 

@@ -71,58 +71,109 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
 }
 
 /* first row (in processing order) whose shift is >= v; shifts are nondecreasing */
-static int first_row_at(const home_context *ctx, int v, int s_min, int s_max, int rows)
+static int first_row_at(const home__theta_geom *g, int v, int rows)
 {
-    if (v <= s_min) return 0;
-    if (v > s_max) return rows;
-    return ctx->first_row[v - s_min];
+    if (v <= g->s_min) return 0;
+    if (v > g->s_max) return rows;
+    return g->first_row[v - g->s_min];
 }
 
-/* One theta row of J, unsmoothed, on the uniform r axis. */
-static void fast_theta_row(home_context *ctx, double theta, float *out)
+void home__hough_raw_rows(const home_config *cfg, int radius, int *first, int *count)
+{
+    /* the stream's smoothed rows run from -3 to theta_bins + 2 (wrap and descriptor margin) */
+    *first = -3 - radius;
+    *count = cfg->theta_bins + 6 + 2 * radius;
+}
+
+void home__theta_geometry(const home_context *ctx, double theta, home__theta_geom *g)
 {
     const double c = cos(theta), s = sin(theta);
     const int vertical = fabs(c) >= fabs(s);
     const int rows = vertical ? ctx->hough_h : ctx->hough_w;
     const int cols = vertical ? ctx->hough_w : ctx->hough_h;
-    const ptrdiff_t img_stride = vertical ? ctx->img_n_stride : ctx->img_t_stride;
-    const uint8_t *img = (vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK; /* column 0 */
     const double a = vertical ? c : s, b = vertical ? s : c, t = -b / a;
     const int flip = t < 0.0; /* process rows so that shifts are nondecreasing */
-    const uint8_t *base = flip ? img + (ptrdiff_t)(rows - 1) * img_stride : img;
-    const ptrdiff_t stride = flip ? -img_stride : img_stride;
     const double centre = 0.5 * (rows - 1), inv_abs_a = 1.0 / fabs(a);
     const double t_processed = flip ? -t : t;
-    int32_t *left = ctx->edge_prefix, *right = ctx->edge_prefix + rows + 1;
-    int32_t *sum = ctx->line_sum;
-    float *line = ctx->line_j;
-    int p, v, j, s_min, s_max, j0, n, n_blocks, blk, i;
+    int p, v, blk, n, j0, s_min, s_max;
 
+    g->vertical = vertical;
+    g->flip = flip;
     for (p = 0; p < rows; p++) {
         /* row rows-1-p in original order: t (centre - p) == -t (p - centre) exactly */
         double x = t_processed * (p - centre) + 0.5;
         int k = (int)x;
-        ctx->shift[p] = (int16_t)(k > x ? k - 1 : k); /* floor without a libm call */
+        g->shift[p] = (int16_t)(k > x ? k - 1 : k); /* floor without a libm call */
     }
-    s_min = ctx->shift[0];
-    s_max = ctx->shift[rows - 1];
+    s_min = g->s_min = g->shift[0];
+    s_max = g->s_max = g->shift[rows - 1];
     /* first_row[v - s_min]: first row whose shift is >= v, for v in [s_min, s_max + 1] */
-    ctx->first_row[0] = 0;
+    g->first_row[0] = 0;
     for (p = 0, v = s_min + 1; v <= s_max; v++) {
-        while (ctx->shift[p] < v) p++;
-        ctx->first_row[v - s_min] = p;
+        while (g->shift[p] < v) p++;
+        g->first_row[v - s_min] = p;
     }
-    ctx->first_row[s_max - s_min + 1] = rows;
+    g->first_row[s_max - s_min + 1] = rows;
     /* intercepts of every line touching the image, plus one on each side for S(j +- 1) */
-    j0 = -s_max - 1;
-    n = cols - s_min - j0 + 1;
-    n_blocks = (n + HOME__RADON_BLOCK - 1) / HOME__RADON_BLOCK;
-    for (blk = 0; blk < n_blocks; blk++) {
+    j0 = g->j0 = -s_max - 1;
+    n = g->n = cols - s_min - j0 + 1;
+    g->n_blocks = (n + HOME__RADON_BLOCK - 1) / HOME__RADON_BLOCK;
+    for (blk = 0; blk < g->n_blocks; blk++) {
         int jb = j0 + blk * HOME__RADON_BLOCK;
-        ctx->row_lo[blk] = (int16_t)first_row_at(ctx, -jb - (HOME__RADON_BLOCK - 1), s_min, s_max, rows);
-        ctx->row_hi[blk] = (int16_t)(first_row_at(ctx, cols - jb, s_min, s_max, rows) - 1);
+        g->row_lo[blk] = (int16_t)first_row_at(g, -jb - (HOME__RADON_BLOCK - 1), rows);
+        g->row_hi[blk] = (int16_t)(first_row_at(g, cols - jb, rows) - 1);
     }
-    ctx->kernels->radon_blocks(base, stride, ctx->shift, j0, n_blocks, ctx->row_lo, ctx->row_hi, sum);
+    g->d_scale = (float)(inv_abs_a / a);
+    g->end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
+    {
+        /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0; the
+         * bins with jf in [0, n - 1) are a contiguous range (jf is monotonic in i), zero elsewhere */
+        const double dj = ctx->cfg.r_step / a;
+        const double jf0 = -0.5 * (ctx->r_bins - 1) * dj + 0.5 * (cols - 1) - j0;
+        const double last = (double)(n - 1);
+        const int r_bins = ctx->r_bins;
+        double lo = dj > 0 ? -jf0 / dj : (last - jf0) / dj;
+        int i_lo = lo <= 0 ? 0 : lo >= r_bins ? r_bins : (int)lo, i_hi, i;
+#define IN_LINE(bin) (jf0 + (bin) * dj >= 0.0 && jf0 + (bin) * dj < last)
+        /* the estimate is within a bin or two: settle it with the exact test */
+        while (i_lo > 0 && IN_LINE(i_lo - 1)) i_lo--;
+        while (i_lo < r_bins && !IN_LINE(i_lo)) i_lo++;
+        i_hi = i_lo;
+        if (i_lo < r_bins) {
+            double hi = dj > 0 ? (last - jf0) / dj : -jf0 / dj;
+            i_hi = hi <= i_lo ? i_lo + 1 : hi >= r_bins ? r_bins : (int)hi;
+            while (i_hi < r_bins && IN_LINE(i_hi)) i_hi++;
+            while (i_hi > i_lo + 1 && !IN_LINE(i_hi - 1)) i_hi--;
+        }
+#undef IN_LINE
+        g->i_lo = i_lo;
+        g->i_hi = i_hi;
+        for (i = i_lo; i < i_hi; i++) {
+            double jf = jf0 + i * dj;
+            int k = (int)jf; /* jf >= 0: truncation is floor */
+            g->res_k[i - i_lo] = (int16_t)k;
+            g->res_f[i - i_lo] = (float)(jf - k);
+        }
+    }
+}
+
+/* One theta row of J, unsmoothed, on the uniform r axis. */
+static void fast_theta_row(home_context *ctx, const home__theta_geom *g, float *out)
+{
+    const int rows = g->vertical ? ctx->hough_h : ctx->hough_w;
+    const int cols = g->vertical ? ctx->hough_w : ctx->hough_h;
+    const ptrdiff_t img_stride = g->vertical ? ctx->img_n_stride : ctx->img_t_stride;
+    const uint8_t *img = (g->vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK; /* column 0 */
+    const uint8_t *base = g->flip ? img + (ptrdiff_t)(rows - 1) * img_stride : img;
+    const ptrdiff_t stride = g->flip ? -img_stride : img_stride;
+    const int16_t *shift = g->shift;
+    const int s_min = g->s_min, s_max = g->s_max, j0 = g->j0, n = g->n;
+    int32_t *left = ctx->edge_prefix, *right = ctx->edge_prefix + rows + 1;
+    int32_t *sum = ctx->line_sum;
+    float *line = ctx->line_j;
+    int p, j, i;
+
+    ctx->kernels->radon_blocks(base, stride, shift, j0, g->n_blocks, g->row_lo, g->row_hi, sum);
 
     /* prefix sums of the first and last column in processing order (the replicated border) */
     left[0] = right[0] = 0;
@@ -132,13 +183,13 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
         right[p + 1] = right[p] + row[cols - 1];
     }
     {
-        const int32_t *fr = ctx->first_row, right_total = right[rows];
+        const int32_t *fr = g->first_row, right_total = right[rows];
         const int span = s_max - s_min + 1;
         /* lines through every row (entry 0, exit rows - 1): no border term, and their end
          * pixels lie on two contiguous rows */
         const int mid_lo = -s_min - j0, mid_hi = cols - s_max - j0; /* [mid_lo, mid_hi) */
-        const uint8_t *first_row_px = base + ctx->shift[0];
-        const uint8_t *last_row_px = base + (ptrdiff_t)(rows - 1) * stride + ctx->shift[rows - 1];
+        const uint8_t *first_row_px = base + shift[0];
+        const uint8_t *last_row_px = base + (ptrdiff_t)(rows - 1) * stride + shift[rows - 1];
         for (i = 0; i < n; i++) {
             int v_entry, v_after, entry, after;
             j = j0 + i;
@@ -154,8 +205,8 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
             after = fr[v_after > span ? span : v_after];
             sum[i] += left[entry] + right_total - right[after];
             if (entry < after) {
-                int first_value = base[(ptrdiff_t)entry * stride + j + ctx->shift[entry]];
-                int last_value = base[(ptrdiff_t)(after - 1) * stride + j + ctx->shift[after - 1]];
+                int first_value = base[(ptrdiff_t)entry * stride + j + shift[entry]];
+                int last_value = base[(ptrdiff_t)(after - 1) * stride + j + shift[after - 1]];
                 line[i] = (float)(last_value - first_value); /* exact: |.| <= 255 */
             } else {
                 line[i] = 0.0f;
@@ -164,39 +215,19 @@ static void fast_theta_row(home_context *ctx, double theta, float *out)
     }
     /* J on the intercept grid (in place over the end terms), then resampled to the r axis */
     {
-        const float d_scale = (float)(inv_abs_a / a);
-        const float end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
+        const float d_scale = g->d_scale, end_scale = g->end_scale;
         for (i = 1; i < n - 1; i++)
             line[i] = d_scale * (float)(sum[i + 1] - sum[i - 1]) + end_scale * line[i];
         line[0] = line[n - 1] = 0.0f;
     }
     {
-        /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0; the
-         * bins with jf in [0, n - 1) are a contiguous range (jf is monotonic in i), zero elsewhere */
-        const double dj = ctx->cfg.r_step / a;
-        const double jf0 = -0.5 * (ctx->r_bins - 1) * dj + 0.5 * (cols - 1) - j0;
-        const double last = (double)(n - 1);
-        const int r_bins = ctx->r_bins;
-        double lo = dj > 0 ? -jf0 / dj : (last - jf0) / dj;
-        int i_lo = lo <= 0 ? 0 : lo >= r_bins ? r_bins : (int)lo, i_hi;
-#define IN_LINE(bin) (jf0 + (bin) * dj >= 0.0 && jf0 + (bin) * dj < last)
-        /* the estimate is within a bin or two: settle it with the exact test */
-        while (i_lo > 0 && IN_LINE(i_lo - 1)) i_lo--;
-        while (i_lo < r_bins && !IN_LINE(i_lo)) i_lo++;
-        i_hi = i_lo;
-        if (i_lo < r_bins) {
-            double hi = dj > 0 ? (last - jf0) / dj : -jf0 / dj;
-            i_hi = hi <= i_lo ? i_lo + 1 : hi >= r_bins ? r_bins : (int)hi;
-            while (i_hi < r_bins && IN_LINE(i_hi)) i_hi++;
-            while (i_hi > i_lo + 1 && !IN_LINE(i_hi - 1)) i_hi--;
-        }
-#undef IN_LINE
+        const int r_bins = ctx->r_bins, i_lo = g->i_lo, i_hi = g->i_hi;
+        const int16_t *rk = g->res_k - i_lo;
+        const float *rf = g->res_f - i_lo;
         for (i = 0; i < i_lo; i++) out[i] = 0.0f;
         for (; i < i_hi; i++) {
-            double jf = jf0 + i * dj;
-            int k = (int)jf; /* jf >= 0: truncation is floor */
-            float f = (float)(jf - k);
-            out[i] = line[k] + f * (line[k + 1] - line[k]);
+            const int k = rk[i];
+            out[i] = line[k] + rf[i] * (line[k + 1] - line[k]);
         }
         for (; i < r_bins; i++) out[i] = 0.0f;
     }
@@ -207,33 +238,36 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
 {
     const int n_theta = ctx->cfg.theta_bins, r_bins = ctx->r_bins, radius = ctx->smooth_radius;
     const int width = ctx->cfg.width, height = ctx->cfg.height;
-    const int first_smooth = -3, last_smooth = n_theta + 2;
-    const int first_raw = first_smooth - radius, last_raw = last_smooth + radius;
+    const int first_smooth = -3;
     const int raw_ring = 2 * radius + 1;
     const double scale = 32768.0 / ctx->cfg.r_step; /* Q16 over doubled coordinates */
     const int32_t base_q = (int32_t)(r_bins / 2) * 65536;
     const float *raw_window[2 * HOME__MAX_SMOOTH_RADIUS + 1];
     const float *window[HOME__DESC_ROWS];
     double t0 = home__now(ctx), spent = 0.0;
-    int k, i;
+    int k, i, first_raw, n_raw;
 
     const int exact = ctx->cfg.hough_method == HOME_HOUGH_EXACT;
     if (exact)
         home__gradient(image, stride, width, height, ctx->grad_x, ctx->grad_y);
     else
         prepare_fast(ctx, image, stride);
-    for (k = first_raw; k <= last_raw; k++) {
-        double theta = k * HOME__PI / n_theta, c = cos(theta), s = sin(theta);
+    home__hough_raw_rows(&ctx->cfg, radius, &first_raw, &n_raw);
+    for (k = first_raw; k < first_raw + n_raw; k++) {
+        const double theta = k * HOME__PI / n_theta;
         float *raw = ctx->raw_rows + (size_t)((k - first_raw) % raw_ring) * r_bins;
         int j;
         if (exact) {
+            const double c = cos(theta), s = sin(theta);
             home__hough_accumulate_row(ctx->grad_x, ctx->grad_y, width, height,
                                        (int32_t)lround(c * scale), (int32_t)lround(s * scale),
                                        base_q, ctx->acc_x, ctx->acc_y, r_bins);
             for (i = 0; i < r_bins; i++)
                 ctx->row_tmp[i] = (float)(c * ctx->acc_x[i] + s * ctx->acc_y[i]);
         } else {
-            fast_theta_row(ctx, theta, ctx->row_tmp);
+            home__theta_geom *g = ctx->geom ? &ctx->geom[k - first_raw] : &ctx->geom_scratch;
+            if (!ctx->geom) home__theta_geometry(ctx, theta, g);
+            fast_theta_row(ctx, g, ctx->row_tmp);
         }
         home__smooth_r(ctx->kernels, ctx->row_tmp, raw, r_bins, ctx->smooth_taps, radius);
         if (k - first_raw < 2 * radius) continue;

@@ -52,6 +52,63 @@ void test_arena_layout(void)
     CHECK_EQ_INT(mem[need], 0xA5);
 }
 
+/* The per-context theta geometry (home_video_config at 640x360 caches it) gives the features
+ * computing it per frame gives, bit for bit, and extraction leaves the cache intact. */
+void test_hough_geometry_cache(void)
+{
+    static union { unsigned char b[(2u << 20) + 64]; double d; } storage;
+    static uint8_t a[640 * 360];
+    static home_features cached, per_frame;
+    static int16_t shift[4096], row_lo[256], row_hi[256], res_k[4 * 4096];
+    static int32_t first_row[4096 + 8];
+    static float res_f[4 * 4096];
+    unsigned char *mem = (unsigned char *)(((uintptr_t)storage.b + 63) & ~(uintptr_t)63);
+    home__theta_geom fresh, *geom;
+    home_config cfg;
+    home_context *ctx;
+    int k, first, rows, bad = 0;
+    home_video_config(&cfg, 640, 360);
+    CHECK(home_arena_size(&cfg) <= sizeof storage.b - 64);
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem, sizeof storage.b - 64, NULL), HOME_OK);
+    CHECK(ctx->geom != NULL);
+    if (!ctx->geom) return;
+    synth_render(SYNTH_STRUCTURED, 4, (const double[9]){1, 0, 0, 0, 1, 0, 0, 0, 1}, 2.5, 9, a, 640, 360, 640);
+    CHECK_EQ_INT(home_extract(ctx, a, 640, &cached), HOME_OK);
+    /* the cache still holds what home__theta_geometry computes */
+    fresh.shift = shift; fresh.row_lo = row_lo; fresh.row_hi = row_hi; fresh.first_row = first_row;
+    fresh.res_k = res_k; fresh.res_f = res_f;
+    home__hough_raw_rows(&ctx->cfg, ctx->smooth_radius, &first, &rows);
+    for (k = 0; k < rows; k++) {
+        const home__theta_geom *g = &ctx->geom[k];
+        const int n_rows = g->vertical ? ctx->hough_h : ctx->hough_w, n_res = g->i_hi - g->i_lo;
+        home__theta_geometry(ctx, (first + k) * HOME__PI / cfg.theta_bins, &fresh);
+        bad += fresh.vertical != g->vertical || fresh.flip != g->flip || fresh.s_min != g->s_min ||
+               fresh.s_max != g->s_max || fresh.j0 != g->j0 || fresh.n != g->n ||
+               fresh.n_blocks != g->n_blocks || fresh.i_lo != g->i_lo || fresh.i_hi != g->i_hi ||
+               fresh.d_scale != g->d_scale || fresh.end_scale != g->end_scale;
+        bad += memcmp(fresh.shift, g->shift, (size_t)n_rows * sizeof *shift) != 0;
+        bad += memcmp(fresh.first_row, g->first_row, (size_t)(g->s_max - g->s_min + 2) * sizeof *first_row) != 0;
+        bad += memcmp(fresh.row_lo, g->row_lo, (size_t)g->n_blocks * sizeof *row_lo) != 0;
+        bad += memcmp(fresh.row_hi, g->row_hi, (size_t)g->n_blocks * sizeof *row_hi) != 0;
+        bad += memcmp(fresh.res_k, g->res_k, (size_t)n_res * sizeof *res_k) != 0;
+        bad += memcmp(fresh.res_f, g->res_f, (size_t)n_res * sizeof *res_f) != 0;
+    }
+    CHECK_EQ_INT(bad, 0);
+    /* the same context computing the geometry per frame into scratch arrays */
+    geom = ctx->geom;
+    ctx->geom = NULL;
+    ctx->geom_scratch = fresh;
+    CHECK_EQ_INT(home_extract(ctx, a, 640, &per_frame), HOME_OK);
+    ctx->geom = geom;
+    CHECK_EQ_INT(per_frame.n_pos + per_frame.n_neg, cached.n_pos + cached.n_neg);
+    CHECK(per_frame.n_pos > 100);
+    CHECK(memcmp(per_frame.kp, cached.kp, (size_t)(cached.n_pos + cached.n_neg) * sizeof *cached.kp) == 0);
+    /* the defaults' full-size transform needs more than the budget: computed per frame */
+    home_default_config(&cfg, 640, 360);
+    CHECK_EQ_INT(home_init(&ctx, &cfg, mem, sizeof storage.b - 64, NULL), HOME_OK);
+    CHECK(ctx->geom == NULL);
+}
+
 void test_heap_keeps_top_k(void)
 {
     static home__candidate store[37];
