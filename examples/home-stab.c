@@ -27,6 +27,8 @@ static void usage(FILE *f)
             "  --smoothing F     path smoothing time constant, frames (default: lookahead / 2, at\n"
             "                    least 3; 15 without lookahead)\n"
             "  --lookahead N     frames of latency for fixed-lag smoothing (default 0)\n"
+            "  --ease F          with a lookahead: share of the pan given up at the clip's ends,\n"
+            "                    0 (keep panning) .. 1 (start from and come to rest); default 0.5\n"
             "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 960 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
@@ -123,7 +125,7 @@ int main(int argc, char **argv)
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
     home_stab_config cfg;
     double margin = 0.10, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0,
-           theta_bins = 0;
+           theta_bins = 0, ease = -1;
     double t_start, ms_reg = 0, ms_warp = 0, last_report;
     app ap;
     home_stab *stab = NULL;
@@ -155,6 +157,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--margin")) { target = &margin; lo = 0; hi = 0.4; }
         else if (!strcmp(a, "--smoothing")) { target = &smoothing; lo = 1; hi = 1000; }
         else if (!strcmp(a, "--lookahead")) { target = &lookahead; lo = 0; hi = HOME_STAB_MAX_LOOKAHEAD; }
+        else if (!strcmp(a, "--ease")) { target = &ease; lo = 0; hi = 1; }
         else if (!strcmp(a, "--downscale")) { target = &downscale; lo = 1; hi = 4; }
         else if (!strcmp(a, "--hough-downscale")) { target = &hough_ds; lo = 1; hi = 4; }
         else if (!strcmp(a, "--theta-bins")) { target = &theta_bins; lo = 16; hi = HOME_MAX_THETA_BINS; }
@@ -176,6 +179,7 @@ int main(int argc, char **argv)
     cfg.margin = (float)margin;
     cfg.smoothing = (float)smoothing;
     cfg.lookahead = (int)lookahead;
+    if (ease >= 0) cfg.ease = (float)ease;
     if (downscale > 0) cfg.downscale = (int)downscale;
     cfg.keypoints_per_sign = (int)keypoints;
     cfg.refine = refine;

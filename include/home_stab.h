@@ -14,9 +14,10 @@
  * newest frame (only its luma is read) and, once N = lookahead frames are queued behind it,
  * reports the warp for the frame pushed N calls earlier; the caller keeps its last N + 1 frames
  * (a ring) and warps the reported one with home_stab_warp() into its output buffer. At the end
- * of a stream home_stab_flush() reports the N frames still queued. Everything else - the HOME
- * context, the two feature slots (previous/current, swapped by pointer), the downscaled luma,
- * the path history - lives in one caller arena of home_stab_arena_size() bytes.
+ * of a stream home_stab_flush() reports the N frames still queued, smoothed over the mirrored
+ * path (see home_stab_config.ease); a push after a flush continues the stream. Everything else -
+ * the HOME context, the two feature slots (previous/current, swapped by pointer), the downscaled
+ * luma, the path history - lives in one caller arena of home_stab_arena_size() bytes.
  *
  * Coordinates as in home.h: pixel centres, (0, 0) top-left. A warp maps output pixel
  * coordinates to input (source) pixel coordinates of the luma plane; chroma follows with
@@ -59,6 +60,12 @@ typedef struct home_stab_config {
                                  1/smoothing per frame); larger = steadier, more crop used;
                                  0 = automatic: lookahead / 2 (at least 3), causal 15 */
     int lookahead;            /* frames of latency used for fixed-lag smoothing; 0 = causal */
+    float ease;               /* with a lookahead: share of the pan the virtual camera gives up
+                                 at the stream's ends, 0..1 (0: the pan goes on through the
+                                 first and last frames, 1: it starts from and comes to rest);
+                                 0.5. The path beyond each end is the mirrored path plus the
+                                 share 1 - ease of its trend, so the end frames are smoothed
+                                 over a full window; no effect when causal */
     int downscale;            /* register on luma box-averaged by 1, 2 or 4 */
     int keypoints_per_sign;   /* HOME's budget per frame (see home_config) */
     int min_inliers;          /* HOME's failure rule (see home_config) */
@@ -109,10 +116,10 @@ typedef struct home_stab_output {
 
 typedef struct home_stab home_stab;
 
-/* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, downscale 2
- * for frames wider than 960 px (else 1), then home_video_config()'s choices for the registration
- * image (500 keypoints per sign, automatic hough_downscale: Hough on a copy about 160 px wide)
- * with 120 theta bins, refinement on. */
+/* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, ease 0.5,
+ * downscale 2 for frames wider than 960 px (else 1), then home_video_config()'s choices for the
+ * registration image (500 keypoints per sign, automatic hough_downscale: Hough on a copy about
+ * 160 px wide) with 120 theta bins, refinement on. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

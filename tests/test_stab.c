@@ -253,6 +253,76 @@ static void test_implausible_jump_held(void)
     CHECK_LT(max_step, 0.1 * CW);
 }
 
+/* Record an emitted frame; 0 when it is out of order or its window leaves the frame. */
+static int take(const home_stab_output *o, int *next, double (*smooth)[2])
+{
+    int ok = o->frame == *next && corners_inside(o->warp);
+    smooth[*next][0] = o->smooth.tx;
+    smooth[*next][1] = o->smooth.ty;
+    ++*next;
+    return ok;
+}
+
+/* Stabilise clip frames [0, n) with lookahead 12 and the given ease, flushing after frame
+ * flush_at too; the smoothed path per frame. 0 unless every frame came once, in order, at the
+ * configured latency, with its window inside the frame. */
+static int run_eased(float ease, int n, int flush_at, double (*smooth)[2])
+{
+    home_stab_config cfg;
+    home_stab *st = NULL;
+    home_stab_output o;
+    home_stab_image im;
+    int t, next = 0, ok = 1;
+    home_stab_default_config(&cfg, CW, CH);
+    cfg.lookahead = 12;
+    cfg.ease = ease;
+    if (home_stab_init(&st, &cfg, ALIGNED_ARENA(arena.bytes), ALIGNED_BYTES(arena.bytes), NULL) != HOME_OK) return 0;
+    render_clip();
+    for (t = 0; t < n; t++) {
+        grey_image(clip[t], &im);
+        if (home_stab_push(st, &im, &o) != HOME_OK) return 0;
+        if (o.ready != (t - next >= 12)) ok = 0;
+        if (o.ready) ok &= take(&o, &next, smooth);
+        if (t == flush_at)
+            while (home_stab_flush(st, &o) == HOME_OK && o.ready) ok &= take(&o, &next, smooth);
+    }
+    while (home_stab_flush(st, &o) == HOME_OK && o.ready) ok &= take(&o, &next, smooth);
+    return ok && next == n;
+}
+
+static double path_speed(double (*p)[2], int from, int to)
+{
+    double sum = 0;
+    int t;
+    for (t = from; t < to; t++) sum += hypot(p[t + 1][0] - p[t][0], p[t + 1][1] - p[t][1]);
+    return sum / (to - from);
+}
+
+/* The ends are smoothed over the mirrored path: with ease 1 the virtual camera starts from and
+ * comes to rest, with ease 0 it keeps the pan (about 0.55 px per frame); either way in order, at
+ * the configured latency, inside the frame. Streams shorter than the lookahead, and pushes after
+ * a flush, work too. */
+static void test_ends_mirrored(void)
+{
+    static double rest[CLIP_FRAMES][2], pan[CLIP_FRAMES][2], part[CLIP_FRAMES][2];
+    double mid, r0, r1, p0, p1;
+    CHECK(run_eased(1.0f, CLIP_FRAMES, -1, rest));
+    CHECK(run_eased(0.0f, CLIP_FRAMES, -1, pan));
+    mid = path_speed(pan, 20, CLIP_FRAMES - 21);
+    r0 = path_speed(rest, 0, 3);
+    r1 = path_speed(rest, CLIP_FRAMES - 4, CLIP_FRAMES - 1);
+    p0 = path_speed(pan, 0, 3);
+    p1 = path_speed(pan, CLIP_FRAMES - 4, CLIP_FRAMES - 1);
+    printf("    smoothed px per frame, first / last 3 frames: ease 1 %.2f / %.2f, ease 0 %.2f / %.2f;"
+           " between %.2f\n", r0, r1, p0, p1, mid);
+    CHECK(mid > 0.4);
+    CHECK_LT(r0, 0.4 * mid);
+    CHECK_LT(r1, 0.4 * mid);
+    CHECK(p0 > 0.7 * mid && p1 > 0.7 * mid);
+    CHECK(run_eased(0.5f, 5, -1, part));
+    CHECK(run_eased(0.5f, 40, 19, part));
+}
+
 static void test_deterministic(void)
 {
     static run_result a, b;
@@ -463,6 +533,8 @@ static void test_api_contract(void)
     bad = cfg; bad.margin = 0.5f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.smoothing = NAN; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.lookahead = HOME_STAB_MAX_LOOKAHEAD + 1; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.ease = 1.5f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.ease = NAN; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.downscale = 3; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.downscale = 8; CHECK(home_stab_validate_config(&bad) != HOME_OK);
     CHECK_EQ_INT(home_stab_arena_size(&bad), 0);
@@ -488,7 +560,8 @@ static void test_api_contract(void)
 #define STAB_TESTS(X) \
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
     X(warp_formats_agree) X(warp_backends_identical) X(jitter_reduced_causal) X(lookahead_latency_and_gain) \
-    X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(deterministic)
+    X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
+    X(deterministic)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
 

@@ -33,7 +33,10 @@ Metrics, all on luma, computed the same way for every method from its output fra
   fps        frames / wall time of the whole process (both passes for vidstab), and frames per
              CPU second (user + system time of the process and all its threads: steadier on a
              shared machine, and fair to multi-threaded filters)
+  ITF ends   the same ITF over the first and last 10 pairs only, and over the pairs between
+             (where a two-pass method, which sees the whole clip, can slow the output down)
 Usage: python3 bench/stab/compare.py [--quick | --smoke] [--build build] [--frames N] [--out DIR]
+         [--methods home-stab,home-stab la15,vidstab,deshake] [--stab-args "--theta-bins 64"]
 """
 import argparse
 import glob
@@ -252,7 +255,7 @@ def valid_mask(m):
     return (u >= 0) & (u <= W - 1) & (v >= 0) & (v <= H - 1)
 
 
-def itf(outs, maps):
+def itf(outs, maps, ends=10):
     vals = []
     masks = [valid_mask(m) for m in maps]
     for t in range(len(outs) - 1):
@@ -261,16 +264,18 @@ def itf(outs, maps):
             continue
         d = outs[t][common].astype(np.float64) - outs[t + 1][common]
         vals.append(10 * np.log10(255.0 ** 2 / max(np.mean(d * d), 1e-6)))
-    return float(np.mean(vals)), float(np.mean([m.mean() for m in masks]))
+    mid = vals[ends:len(vals) - ends] if len(vals) > 2 * ends else vals
+    end = vals[:ends] + vals[len(vals) - ends:] if len(vals) > 2 * ends else vals
+    return float(np.mean(vals)), float(np.mean([m.mean() for m in masks])), float(np.mean(end)), float(np.mean(mid))
 
 
 def measure(outs, ins, truth, intended):
     maps = output_maps(outs, ins)
     o = np.array([np.linalg.inv(m) @ g for m, g in zip(maps, truth)])
     path = components(o)
-    it, valid = itf(outs, maps)
+    it, valid, it_ends, it_mid = itf(outs, maps)
     crop = float(np.mean(np.sqrt(np.abs(np.linalg.det(maps[:, :2, :2])))))
-    return {"jitter": jitter(path), "itf": it, "stability": stability(path), "crop": min(crop, 1.0), "valid": valid,
+    return {"jitter": jitter(path), "itf": it, "itf_ends": it_ends, "itf_mid": it_mid, "stability": stability(path), "crop": min(crop, 1.0), "valid": valid,
             "follow": follow(path, components(intended), crop)}
 
 
@@ -284,6 +289,9 @@ def main():
     ap.add_argument("--smoke", action="store_true", help="CI: one structured clip of 40 frames")
     ap.add_argument("--out", default=None, help="work directory (default BUILD/bench-stab)")
     ap.add_argument("--cache", default=os.environ.get("HOME_EVAL_CACHE", str(REPO / "build/eval-cache")))
+    ap.add_argument("--methods", default="home-stab,home-stab la15,vidstab,deshake",
+                    help="comma-separated subset of the methods to run")
+    ap.add_argument("--stab-args", default="", help="extra home-stab options (e.g. --theta-bins 64)")
     args = ap.parse_args()
     build = REPO / args.build
     work = Path(args.out) if args.out else build / "bench-stab"
@@ -295,9 +303,10 @@ def main():
         if not tool.exists():
             sys.exit("%s missing: run make BUILD=%s first" % (tool, args.build))
 
+    extra = args.stab_args.split()
     methods = {
-        "home-stab": lambda c, o: [[str(stab), "--quiet", c, o]],
-        "home-stab la15": lambda c, o: [[str(stab), "--quiet", "--lookahead", "15", c, o]],
+        "home-stab": lambda c, o: [[str(stab), "--quiet"] + extra + [c, o]],
+        "home-stab la15": lambda c, o: [[str(stab), "--quiet", "--lookahead", "15"] + extra + [c, o]],
         "vidstab": lambda c, o: [
             ["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "vidstabdetect=result=%s.trf" % o, "-f", "null", "-"],
             ["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "vidstabtransform=input=%s.trf:crop=black:optzoom=1:smoothing=15" % o,
@@ -305,6 +314,11 @@ def main():
         "deshake": lambda c, o: [["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "deshake=edge=blank", "-pix_fmt", "yuv420p",
                                   "-f", "yuv4mpegpipe", o]],
     }
+    chosen = [m.strip() for m in args.methods.split(",")]
+    for m in chosen:
+        if m not in methods:
+            sys.exit("unknown method %r (known: %s)" % (m, ", ".join(methods)))
+    methods = {k: v for k, v in methods.items() if k in chosen}
     results = {}   # (category, method) -> list of metric dicts
     input_jitter = {}
     for cat, items in PHOTOS.items():
@@ -335,18 +349,18 @@ def main():
                 m["fps"] = len(ins) / wall
                 m["cpu_fps"] = len(ins) / cpu
                 results.setdefault((cat, mname), []).append(m)
-                print("%-12s %-22s %-15s jitter %6.3f px  ITF %6.2f dB  stability %.3f  crop %.3f  valid %.3f  follow %5.2f px  %6.1f fps (%.1f per CPU s)" %
-                      (cat, Path(name).stem + (" a=%.1f" % decay if decay else ""), mname, m["jitter"], m["itf"],
+                print("%-12s %-22s %-15s jitter %6.3f px  ITF %6.2f dB (ends %6.2f, between %6.2f)  stability %.3f  crop %.3f  valid %.3f  follow %5.2f px  %6.1f fps (%.1f per CPU s)" %
+                      (cat, Path(name).stem + (" a=%.1f" % decay if decay else ""), mname, m["jitter"], m["itf"], m["itf_ends"], m["itf_mid"],
                        m["stability"], m["crop"], m["valid"], m["follow"], m["fps"], m["cpu_fps"]), flush=True)
 
     print("\n%d frames of %dx%d per clip; input jitter (px RMS):" % (frames, W, H),
           ", ".join("%s %.2f" % (c, np.mean(v)) for c, v in input_jitter.items()))
-    print("\n| category | method | jitter px | ITF dB | stability | crop | valid | follow px | fps (wall) | frames per CPU s |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("\n| category | method | jitter px | ITF dB | ITF ends / between | stability | crop | valid | follow px | fps (wall) | frames per CPU s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for (cat, mname), ms in results.items():
         avg = {k: np.mean([m[k] for m in ms]) for k in ms[0]}
-        print("| %s | %s | %.3f | %.2f | %.3f | %.3f | %.3f | %.2f | %.1f | %.1f |" %
-              (cat, mname, avg["jitter"], avg["itf"], avg["stability"], avg["crop"], avg["valid"], avg["follow"], avg["fps"],
+        print("| %s | %s | %.3f | %.2f | %.2f / %.2f | %.3f | %.3f | %.3f | %.2f | %.1f | %.1f |" %
+              (cat, mname, avg["jitter"], avg["itf"], avg["itf_ends"], avg["itf_mid"], avg["stability"], avg["crop"], avg["valid"], avg["follow"], avg["fps"],
                avg["cpu_fps"]))
 
 
