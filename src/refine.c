@@ -622,6 +622,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
         if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return; }
     }
     for (level = st->levels - 1; level >= s.finest; level--) {
+        double last_step = INFINITY;
         converged = 0;
         for (it = 0; it < ctx->cfg.refine_iterations; it++) {
             iterations++;
@@ -631,6 +632,9 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
                 return;
             }
             if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
+            /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
+            if (step > 0.5 * last_step) s.hessian_level = -1;
+            last_step = step;
         }
     }
     result->refine_iterations = iterations;
