@@ -46,6 +46,8 @@ static void usage(FILE *f)
         "  --no-refine          keep HOME's homography (no photometric refinement)\n"
         "  --refine-levels N    refinement pyramid levels (default 3)\n"
         "  --refine-iterations N  Gauss-Newton iteration cap per level (default 10)\n"
+        "  --refine-points N    refinement template points at full size, halved per level\n"
+        "                       (default 4096, 64..4096)\n"
         "  --refine-trust PX    largest corner motion the refinement may make, in Hough-image\n"
         "                       px (default 6)\n"
         "  --repeat N           register N times; ms are medians, plus \"frame\": one new frame\n"
@@ -136,7 +138,7 @@ int main(int argc, char **argv)
     const char *paths[2] = {NULL, NULL}, *hough_path = NULL;
     home_config cfg;
     int n_paths = 0, i, repeat = 1, status, s, video = 0;
-    int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_downscale = -1,
+    int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_rpoints = -1, opt_downscale = -1,
         opt_window = -1;
     float opt_rtrust = -1;
     float opt_ratio = -1, opt_thr = -1, opt_thr0 = -1, opt_rstep = -1, opt_sigma = -1;
@@ -164,6 +166,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--min-inliers")) bad = parse_int(v, &opt_min_in), i++;
         else if (!strcmp(a, "--refine-levels")) bad = parse_int(v, &opt_rlevels), i++;
         else if (!strcmp(a, "--refine-iterations")) bad = parse_int(v, &opt_riters), i++;
+        else if (!strcmp(a, "--refine-points")) bad = parse_int(v, &opt_rpoints), i++;
         else if (!strcmp(a, "--refine-trust")) bad = parse_float(v, &opt_rtrust), i++;
         else if (!strcmp(a, "--repeat")) bad = parse_int(v, &repeat) || repeat < 1 || repeat > 10000, i++;
         else if (!strcmp(a, "--ratio")) bad = parse_float(v, &opt_ratio), i++;
@@ -206,6 +209,7 @@ int main(int argc, char **argv)
     if (opt_window >= 0) cfg.match_theta_window = opt_window;
     if (opt_rlevels >= 0) cfg.refine_levels = opt_rlevels;
     if (opt_riters >= 0) cfg.refine_iterations = opt_riters;
+    if (opt_rpoints >= 0) cfg.refine_points = opt_rpoints;
     if (opt_rtrust >= 0) cfg.refine_trust_px = opt_rtrust;
     if (cfg.wrap_band > cfg.theta_bins / 4) cfg.wrap_band = cfg.theta_bins / 18;
     cfg.clock = clock_ms;

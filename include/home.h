@@ -86,6 +86,9 @@ typedef struct home_config {
     int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
     float refine_trust_px;    /* largest corner motion from HOME's H accepted, in px of the
                                  Hough image (x hough_downscale in the image); default 6 */
+    int refine_points;        /* template points at full resolution (halved per coarser level,
+                                 at least 64), 64..HOME_REFINE_MAX_POINTS; default the maximum
+                                 (4096): fewer cost proportionally less per iteration */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
     int hough_downscale;      /* 1: Hough transform of the image itself; 2 or 4: of its 2x2- or

@@ -52,9 +52,9 @@ static int block_side(int level) { return level == 2 ? 2 : 4; }
  * gives too few to refine. */
 static int score_floor(int level) { return level == 0 ? 8 : level == 1 ? 4 : 3; }
 
-static int level_capacity(int level)
+static int level_capacity(const home_config *cfg, int level)
 {
-    int c = HOME_REFINE_MAX_POINTS >> level;
+    int c = cfg->refine_points >> level;
     c = c < 64 ? 64 : c;
     return (c + LANES - 1) & ~(LANES - 1);
 }
@@ -67,6 +67,7 @@ void home__refine_defaults(home_config *cfg)
     cfg->refine_levels = HOME_REFINE_MAX_LEVELS < 3 ? HOME_REFINE_MAX_LEVELS : 3;
     cfg->refine_iterations = 10;
     cfg->refine_trust_px = 6.0f;
+    cfg->refine_points = HOME_REFINE_MAX_POINTS;
 }
 
 int home__refine_validate(const home_config *cfg)
@@ -75,6 +76,7 @@ int home__refine_validate(const home_config *cfg)
     if (cfg->refine_levels < 0 || cfg->refine_levels > HOME_REFINE_MAX_LEVELS) return HOME_E_CONFIG;
     if (cfg->refine_iterations < 1 || cfg->refine_iterations > HOME_REFINE_MAX_ITERS)
         return HOME_E_CONFIG;
+    if (cfg->refine_points < 64 || cfg->refine_points > HOME_REFINE_MAX_POINTS) return HOME_E_CONFIG;
     if (!(isfinite(cfg->refine_trust_px) && cfg->refine_trust_px >= 0.05f &&
           cfg->refine_trust_px <= 256.0f))
         return HOME_E_CONFIG;
@@ -102,7 +104,7 @@ static size_t blocks_at(const home_config *cfg, int level)
  * time a row of int16 for the blur and a row of selection keys, then the block cells. */
 static size_t scratch_bytes(const home_config *cfg)
 {
-    size_t match = 4 * (size_t)level_capacity(0) * sizeof(float), sel = 0;
+    size_t match = 4 * (size_t)level_capacity(cfg, 0) * sizeof(float), sel = 0;
     int l;
     for (l = 0; l < levels_for(cfg); l++) {
         size_t s = blocks_at(cfg, l) * sizeof(uint16_t);
@@ -118,7 +120,7 @@ size_t home__refine_bytes(const home_config *cfg)
     int l, n = cfg->refine_levels ? levels_for(cfg) : 0;
     for (l = 0; l < n; l++) {
         total += align64((size_t)(cfg->width >> l) * (size_t)(cfg->height >> l));
-        total += 2 * 5 * align64((size_t)(level_capacity(l) + LANES) * sizeof(int16_t));
+        total += 2 * 5 * align64((size_t)(level_capacity(cfg, l) + LANES) * sizeof(int16_t));
     }
     if (n) total += align64(scratch_bytes(cfg));
     return total;
@@ -139,8 +141,8 @@ void home__refine_init(home_context *ctx, unsigned char *block)
         block += align64((size_t)st->w[l] * (size_t)st->h[l]);
         for (s = 0; s < 2; s++) {
             home__refine_points *p = &st->tpl[s][l];
-            size_t bytes = align64((size_t)(level_capacity(l) + LANES) * sizeof(int16_t));
-            p->capacity = level_capacity(l);
+            size_t bytes = align64((size_t)(level_capacity(&ctx->cfg, l) + LANES) * sizeof(int16_t));
+            p->capacity = level_capacity(&ctx->cfg, l);
             p->x = (int16_t *)(void *)block; block += bytes;
             p->y = (int16_t *)(void *)block; block += bytes;
             p->t = (int16_t *)(void *)block; block += bytes;
@@ -600,7 +602,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0;
     int level, it, converged = 0, iterations = 0;
     float *scratch = (float *)st->scratch;
-    const int cap = level_capacity(0);
+    const int cap = level_capacity(&ctx->cfg, 0);
 
     memset(&s, 0, sizeof s);
     s.st = st;

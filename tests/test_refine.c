@@ -128,6 +128,34 @@ void test_textured_subpixel(void)
     }
 }
 
+/* A smaller point budget: a quarter of the points still refine to sub-pixel, in a smaller
+ * arena, and the template holds no more points than the budget. */
+void test_point_budget(void)
+{
+    home_config cfg;
+    home_context *ctx;
+    size_t full;
+    int k;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    full = home_arena_size(&cfg);
+    cfg.refine_points = HOME_REFINE_MAX_POINTS / 4;
+    CHECK(home_arena_size(&cfg) < full);
+    ctx = context(&cfg);
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 2; k++) {
+        double h[9], err;
+        home_result res;
+        textured_pair(100 + k, 10 + 15 * k, 1.0, h);
+        err = refine_from(ctx, h, 2.0, 7 + k, &res);
+        printf("     %d points, textured p=%d: start 2 px off -> %.3f px, status %d\n",
+               cfg.refine_points, 10 + 15 * k, err, res.refine_status);
+        CHECK(res.refined);
+        CHECK_LT(err, 0.15);
+        CHECK(ctx->refine.tpl[0][0].n + ctx->refine.tpl[1][0].n <= 2 * cfg.refine_points);
+        CHECK(ctx->refine.tpl[0][0].n > cfg.refine_points / 2);
+    }
+}
+
 void test_lines_subpixel(void)
 {
     home_context *ctx = context(NULL);
@@ -516,6 +544,8 @@ void test_arena_and_config(void)
     bad = cfg; bad.refine_levels = -1; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.refine_iterations = 0; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.refine_trust_px = (float)NAN; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.refine_points = 63; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.refine_points = HOME_REFINE_MAX_POINTS + 1; CHECK_EQ_INT(home_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.refine_levels = 0; bad.refine_iterations = 0; CHECK_EQ_INT(home_validate_config(&bad), HOME_OK);
     /* smallest images still get a usable pyramid */
     CHECK_EQ_INT(home_default_config(&cfg, HOME_MIN_SIDE, HOME_MIN_SIDE), HOME_OK);
@@ -541,7 +571,7 @@ void test_refine_bad_inputs(void)
 }
 
 #define TEST_LIST(X) \
-    X(kernels_match_references) X(kernels_backends_identical) X(arena_and_config) X(textured_subpixel) X(lines_subpixel) \
+    X(kernels_match_references) X(kernels_backends_identical) X(arena_and_config) X(textured_subpixel) X(point_budget) X(lines_subpixel) \
     X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
