@@ -34,7 +34,7 @@ static void usage(FILE *f)
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
             "                    its 1/2 or 1/4 size copy (2, 4; default: the one about 160 px wide)\n"
-            "  --theta-bins N    HOME's theta bins (16..%d; default 120)\n"
+            "  --theta-bins N    HOME's theta bins (16..%d; default 88)\n"
             "  --side-by-side    write original | stabilised, twice as wide\n"
             "  --csv FILE        per frame: raw and smoothed camera path (tx, ty px, angle rad,\n"
             "                    log scale), share of the correction applied, and the warp\n"

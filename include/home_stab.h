@@ -74,8 +74,9 @@ typedef struct home_stab_config {
     int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
                                  2x2- or 4x4-box downscaled copy (2, 4), see home_config; 0 =
                                  automatic (home_video_config's: a copy about 160 px wide) */
-    int theta_bins;           /* HOME's theta bins; 0 = automatic (120: half home_video_config's,
-                                 the refinement gives the precision); fewer suit tiny frames */
+    int theta_bins;           /* HOME's theta bins; 0 = automatic (88, about half
+                                 home_video_config's: the refinement gives the precision);
+                                 fewer suit tiny frames */
     int simd;                 /* enum home_simd for HOME and the warp (default: HOME_SIMD env or
                                  the best compiled in) */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
@@ -119,7 +120,7 @@ typedef struct home_stab home_stab;
 /* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, ease 0.5,
  * downscale 2 for frames wider than 960 px (else 1), then home_video_config()'s choices for the
  * registration image (500 keypoints per sign, automatic hough_downscale: Hough on a copy about
- * 160 px wide) with 120 theta bins, refinement on. */
+ * 160 px wide) with 88 theta bins, refinement on. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

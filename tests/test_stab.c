@@ -182,7 +182,7 @@ static void test_downscaled_registration(void)
     CHECK(r.inside);
 }
 
-/* Fewer theta bins than the automatic 120 (cheaper Hough transform) still stabilise. */
+/* Fewer theta bins than the automatic 88 (cheaper Hough transform) still stabilise. */
 static void test_fewer_theta_bins(void)
 {
     static run_result r;
