@@ -73,7 +73,8 @@ static void select_keys_avx2(const uint8_t *row, ptrdiff_t stride, int w, int b,
 }
 
 const home__refine_kernels home__refine_kernels_avx2 = {
-    "avx2", blur3_avx2, home__refine_downsample_sse, select_keys_avx2, home__refine_warp_sse,
+    "avx2", blur3_avx2, home__refine_downsample_sse, select_keys_avx2, home__refine_block_max_sse,
+    home__refine_warp_sse,
     home__refine_accumulate_sse, home__refine_cauchy_sums_sse, home__refine_residuals_sse};
 #else
 typedef int home__refine_avx2_unused; /* ISO C forbids an empty translation unit */

@@ -26,6 +26,9 @@ typedef struct home__refine_kernels {
      * to 0 when storing. b is 1, 2 or 4. */
     void (*select_keys)(const uint8_t *row, ptrdiff_t stride, int w, int b, int dy,
                         int16_t *keys, int accumulate);
+    /* Largest key of each group of b (2 or 4): cells[i] = max(keys[b i .. b i + b - 1]) for
+     * i < n; keys are non-negative. */
+    void (*block_max)(const int16_t *keys, int n, int b, uint16_t *cells);
     /* Bilinear samples at m * (x, y, 1) after the perspective divide (one reciprocal 1 / d, then
      * two products), -1 where the point maps behind the camera or its 2x2 support leaves the
      * w x h image. n is a multiple of 4. */
@@ -82,6 +85,17 @@ static inline void home__blur3_horizontal(const int16_t *tmp, uint8_t *d, int x0
     d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
 }
 
+/* block maxima for blocks [i0, n) (see block_max) */
+static inline void home__block_max_px(const int16_t *keys, int i0, int n, int b, uint16_t *cells)
+{
+    int i, k;
+    for (i = i0; i < n; i++) {
+        int best = keys[b * i];
+        for (k = 1; k < b; k++) best = keys[b * i + k] > best ? keys[b * i + k] : best;
+        cells[i] = (uint16_t)best;
+    }
+}
+
 /* selection keys for x in [x0, w - 1) (see select_keys) */
 static inline void home__select_keys_px(const uint8_t *row, ptrdiff_t stride, int x0, int w, int b,
                                         int dy, int16_t *keys, int accumulate)
@@ -100,6 +114,7 @@ extern const home__refine_kernels home__refine_kernels_sse;
 /* shared by the AVX2 table (port/refine_avx2.c), which replaces the blur and the keys */
 void home__refine_downsample_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
                                  ptrdiff_t dst_stride, int dst_w, int dst_h);
+void home__refine_block_max_sse(const int16_t *keys, int n, int b, uint16_t *cells);
 void home__refine_warp_sse(const float *m, const int16_t *xs, const int16_t *ys, int n,
                            const uint8_t *img, ptrdiff_t stride, int w, int h, float *out);
 void home__refine_accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,

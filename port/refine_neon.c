@@ -65,6 +65,27 @@ static void select_keys_neon(const uint8_t *row, ptrdiff_t stride, int w, int b,
     home__select_keys_px(row, stride, x, w, b, dy, keys, accumulate);
 }
 
+/* pairwise maxima (vpmax on 64-bit halves, in armv7 and aarch64 alike): one round for pairs,
+ * two for groups of four */
+static void block_max_neon(const int16_t *keys, int n, int b, uint16_t *cells)
+{
+    int i = 0;
+    if (b == 2) {
+        for (; i + 4 <= n; i += 4) {
+            int16x8_t v = vld1q_s16(keys + 2 * i);
+            vst1_u16(cells + i, vreinterpret_u16_s16(vpmax_s16(vget_low_s16(v), vget_high_s16(v))));
+        }
+    } else if (b == 4) {
+        for (; i + 4 <= n; i += 4) {
+            int16x8_t v = vld1q_s16(keys + 4 * i), w = vld1q_s16(keys + 4 * i + 8);
+            int16x4_t pv = vpmax_s16(vget_low_s16(v), vget_high_s16(v));
+            int16x4_t pw = vpmax_s16(vget_low_s16(w), vget_high_s16(w));
+            vst1_u16(cells + i, vreinterpret_u16_s16(vpmax_s16(pv, pw)));
+        }
+    }
+    home__block_max_px(keys, i, n, b, cells);
+}
+
 static float32x4_t load4_s16(const int16_t *p)
 {
     return vcvtq_f32_s32(vmovl_s16(vld1_s16(p)));
@@ -207,7 +228,7 @@ static void residuals_neon(const float *b, const int16_t *t, const float *wt, in
 }
 
 const home__refine_kernels home__refine_kernels_neon = {
-    "neon", blur3_neon, downsample_neon, select_keys_neon, warp_neon, accumulate_neon,
+    "neon", blur3_neon, downsample_neon, select_keys_neon, block_max_neon, warp_neon, accumulate_neon,
     cauchy_sums_neon, residuals_neon};
 #else
 typedef int home__refine_neon_unused; /* ISO C forbids an empty translation unit */

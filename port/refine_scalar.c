@@ -83,6 +83,11 @@ static void accumulate_scalar(const int16_t *xs, const int16_t *ys, const int16_
     }
 }
 
+static void block_max_scalar(const int16_t *keys, int n, int b, uint16_t *cells)
+{
+    home__block_max_px(keys, 0, n, b, cells);
+}
+
 static int cauchy_sums_scalar(const float *b, const float *keep, const int16_t *t, int n,
                               int n_valid, float alpha, float beta, float inv_c, float *wt,
                               float *part)
@@ -115,5 +120,6 @@ static void residuals_scalar(const float *b, const int16_t *t, const float *wt, 
 }
 
 const home__refine_kernels home__refine_kernels_scalar = {
-    "none", blur3_scalar, downsample_scalar, select_keys_scalar, warp_scalar, accumulate_scalar,
+    "none", blur3_scalar, downsample_scalar, select_keys_scalar, block_max_scalar, warp_scalar,
+    accumulate_scalar,
     cauchy_sums_scalar, residuals_scalar};

@@ -137,6 +137,38 @@ void home__refine_warp_sse(const float *m, const int16_t *xs, const int16_t *ys,
     }
 }
 
+/* The maximum of each 2- or 4-lane group lands in the group's first lane (shifts within 32- or
+ * 64-bit lanes), then packs gather those lanes (values < 2^15: signed packing is exact). */
+void home__refine_block_max_sse(const int16_t *keys, int n, int b, uint16_t *cells)
+{
+    const __m128i low16 = _mm_set1_epi32(0xffff);
+    int i = 0;
+    if (b == 2) {
+        for (; i + 8 <= n; i += 8) {
+            __m128i v = _mm_loadu_si128((const __m128i *)(const void *)(keys + 2 * i));
+            __m128i w = _mm_loadu_si128((const __m128i *)(const void *)(keys + 2 * i + 8));
+            v = _mm_and_si128(_mm_max_epi16(v, _mm_srli_epi32(v, 16)), low16);
+            w = _mm_and_si128(_mm_max_epi16(w, _mm_srli_epi32(w, 16)), low16);
+            _mm_storeu_si128((__m128i *)(void *)(cells + i), _mm_packs_epi32(v, w));
+        }
+    } else if (b == 4) {
+        const __m128i low64 = _mm_set_epi32(0, 0xffff, 0, 0xffff);
+        for (; i + 8 <= n; i += 8) {
+            __m128i q[4];
+            int j;
+            for (j = 0; j < 4; j++) {
+                __m128i v = _mm_loadu_si128((const __m128i *)(const void *)(keys + 4 * i + 8 * j));
+                v = _mm_max_epi16(v, _mm_srli_epi64(v, 16));
+                q[j] = _mm_and_si128(_mm_max_epi16(v, _mm_srli_epi64(v, 32)), low64);
+            }
+            /* 32-bit lanes 0 and 2 of each hold two blocks' maxima: pack twice */
+            _mm_storeu_si128((__m128i *)(void *)(cells + i),
+                             _mm_packs_epi32(_mm_packs_epi32(q[0], q[1]), _mm_packs_epi32(q[2], q[3])));
+        }
+    }
+    home__block_max_px(keys, i, n, b, cells);
+}
+
 void home__refine_accumulate_sse(const int16_t *xs, const int16_t *ys, const int16_t *gxs,
                                  const int16_t *gys, const float *r, const float *w, int n,
                                  const float *aff, int hessian, float *acc)
@@ -214,7 +246,8 @@ void home__refine_residuals_sse(const float *b, const int16_t *t, const float *w
 }
 
 const home__refine_kernels home__refine_kernels_sse = {
-    "sse", blur3_sse, home__refine_downsample_sse, select_keys_sse, home__refine_warp_sse,
+    "sse", blur3_sse, home__refine_downsample_sse, select_keys_sse, home__refine_block_max_sse,
+    home__refine_warp_sse,
     home__refine_accumulate_sse, home__refine_cauchy_sums_sse, home__refine_residuals_sse};
 #else
 typedef int home__refine_sse_unused; /* ISO C forbids an empty translation unit */

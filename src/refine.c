@@ -191,25 +191,15 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
             rk->select_keys(img + (ptrdiff_t)y * w, w, w, b, dy, keys, rows++ > 0);
         }
         if (!rows) memset(keys, 0, (size_t)w * sizeof *keys);
-        for (bx = 0; bx < w / b; bx++) {   /* whole blocks */
-            const int16_t *k = keys + bx * b;
-            int best = k[0];
-            if (b > 1) best = k[1] > best ? k[1] : best;
-            if (b > 2) {
-                best = k[2] > best ? k[2] : best;
-                best = k[3] > best ? k[3] : best;
-            }
-            cells[by * bw + bx] = (uint16_t)best;
-            /* bin = score / 2; four interleaved histograms: flat runs hit one bin, and one
-             * counter would serialise on its own increments */
-            hist4[bx & 3][best >> 5 > 255 ? 255 : best >> 5]++;
-        }
-        for (; bx < bw; bx++) {             /* a partial block at the right edge */
+        rk->block_max(keys, w / b, b, cells + by * bw);    /* whole blocks */
+        for (bx = w / b; bx < bw; bx++) {                   /* a partial block at the right edge */
             int best = 0;
             for (x = bx * b; x < w; x++) best = keys[x] > best ? keys[x] : best;
             cells[by * bw + bx] = (uint16_t)best;
-            hist4[0][best >> 5 > 255 ? 255 : best >> 5]++;
         }
+        /* bin = score / 2 (keys < 2^13: at most 255); four interleaved histograms: flat runs
+         * hit one bin, and one counter would serialise on its own increments */
+        for (bx = 0; bx < bw; bx++) hist4[bx & 3][cells[by * bw + bx] >> 5]++;
     }
     for (i = 0; i < 256; i++) hist[i] = hist4[0][i] + hist4[1][i] + hist4[2][i] + hist4[3][i];
     /* the lowest bin that still fits the capacity, not below the floor */
@@ -225,9 +215,22 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
         for (bx = 0; bx < bw; bx++, i++) {
             /* branch-free compaction: always write, advance only when kept (the arrays have
              * a lane of slack); only the cut bin's members take a branch */
-            const int key = cells[i];
-            int keep;
-            bin = key >> 5 > 255 ? 255 : key >> 5;
+            int key, keep;
+            if ((bx & 3) == 0 && bx + 4 <= bw) {
+                /* four blocks all below the cut bin (most, with a small budget): skip them.
+                 * Each 16-bit lane plus 2^15 - (cut << 5) stays below 2^16 (keys < 2^13), and
+                 * its top bit is set exactly when that key is in the cut bin or above. */
+                uint64_t four;
+                memcpy(&four, cells + i, sizeof four);
+                if (!((four + (0x8000u - ((unsigned)cut << 5)) * 0x0001000100010001ull) &
+                      0x8000800080008000ull)) {
+                    bx += 3;
+                    i += 3;
+                    continue;
+                }
+            }
+            key = cells[i];
+            bin = key >> 5;
             keep = bin > cut;
             if (bin == cut) {
                 keep = (long)(j + 1) * quota / hist[cut] != (long)j * quota / hist[cut];

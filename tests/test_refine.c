@@ -421,6 +421,22 @@ void test_kernels_match_references(void)
         bad += fabs(s - ref[j]) > 1e-4 * (fabs(ref[j]) + 1.0);
     }
     CHECK_EQ_INT(bad, 0);
+    /* block maxima: the largest of each group of 2 or 4 */
+    {
+        static int16_t keys[4 * 37];
+        static uint16_t cells[37];
+        int b;
+        for (i = 0; i < 4 * 37; i++) keys[i] = (int16_t)(synth_uniform(&rng) * 8192);
+        for (b = 2; b <= 4; b += 2) {
+            k->block_max(keys, 37, b, cells);
+            for (i = 0, bad = 0; i < 37; i++) {
+                int best = 0, q;
+                for (q = 0; q < b; q++) best = keys[b * i + q] > best ? keys[b * i + q] : best;
+                bad += cells[i] != best;
+            }
+            CHECK_EQ_INT(bad, 0);
+        }
+    }
     /* J^T W r alone (hessian = 0): the same sums, J^T W J left untouched */
     {
         static float grad_only[44 * 4];
@@ -502,6 +518,14 @@ void test_kernels_backends_identical(void)
                     k->select_keys(in + 101 * (dy + 1), 101, width, b, dy, k_simd, dy > 0);
                     CHECK(memcmp(k_ref, k_simd, (size_t)width * sizeof *k_ref) == 0);
                 }
+            for (b = 2; b <= 4; b += 2) {
+                /* keys from the rows above (non-negative, < 2^13), an odd count of blocks */
+                static uint16_t c_ref[64], c_simd[64];
+                const int blocks = (width - 1) / b;
+                ref->block_max(k_ref, blocks, b, c_ref);
+                k->block_max(k_ref, blocks, b, c_simd);
+                CHECK(memcmp(c_ref, c_simd, (size_t)blocks * sizeof *c_ref) == 0);
+            }
             ref->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_ref);
             k->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_simd);
             CHECK(memcmp(o_ref, o_simd, 256 * sizeof *o_ref) == 0);
