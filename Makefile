@@ -43,6 +43,10 @@ $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_inte
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_LIB) -c $< -o $@
 
+# The Hough transform's per-theta loops (J from the line sums, the lines' end pixels) are plain
+# element-wise loops that -O2's cheapest vectoriser leaves scalar: 0.4 M instructions per video
+# frame. Element-wise IEEE operations in C99 mode (no contraction), so bit-identical output.
+$(BUILD)/obj/src/hough.o: CFLAGS_LIB += -ftree-vectorize
 $(BUILD)/obj/port/avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 $(BUILD)/obj/port/%.o: port/%.c include/home.h include/home_limits.h port/kernels.h
 	@mkdir -p $(dir $@)
