@@ -75,8 +75,39 @@ static void smooth_cols_avx2(const float *const *rows, float *out, int n, const 
     }
 }
 
+/* The SSE2 kernel's test on eight bins per step; the rest of the row through it. */
+static int extremum_candidates_avx2(const float *up, const float *mid, const float *down, int n,
+                                    int *idx)
+{
+    const __m256 zero = _mm256_setzero_ps();
+    int i, count = 0;
+    for (i = 1; i + 8 <= n - 1; i += 8) {
+        __m256 v = _mm256_loadu_ps(mid + i);
+        __m256 a = _mm256_loadu_ps(up + i - 1), b = _mm256_loadu_ps(up + i), c = _mm256_loadu_ps(up + i + 1);
+        __m256 d = _mm256_loadu_ps(mid + i - 1), e = _mm256_loadu_ps(mid + i + 1);
+        __m256 f = _mm256_loadu_ps(down + i - 1), g = _mm256_loadu_ps(down + i), h = _mm256_loadu_ps(down + i + 1);
+        __m256 hi = _mm256_max_ps(_mm256_max_ps(_mm256_max_ps(a, b), _mm256_max_ps(c, d)),
+                                  _mm256_max_ps(_mm256_max_ps(e, f), _mm256_max_ps(g, h)));
+        __m256 lo = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(a, b), _mm256_min_ps(c, d)),
+                                  _mm256_min_ps(_mm256_min_ps(e, f), _mm256_min_ps(g, h)));
+        __m256 pos = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, hi, _CMP_GT_OQ));
+        __m256 neg = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_LT_OQ), _mm256_cmp_ps(v, lo, _CMP_LT_OQ));
+        int mask = _mm256_movemask_ps(_mm256_or_ps(pos, neg)), lane;
+        for (lane = 0; mask; lane++, mask >>= 1)
+            if (mask & 1) idx[count++] = i + lane;
+    }
+    /* the remaining bins: the SSE2 kernel from i - 1 (it starts at index 1 of what it gets) */
+    if (i < n - 1) {
+        int k, tail = home__extremum_candidates_sse(up + i - 1, mid + i - 1, down + i - 1, n - i + 1, idx + count);
+        for (k = 0; k < tail; k++) idx[count + k] += i - 1;
+        count += tail;
+    }
+    return count;
+}
+
 const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
                                           smooth_row_avx2, smooth_cols_avx2, home__box_down_sse,
+                                          extremum_candidates_avx2,
     &home__refine_kernels_avx2, &home__stab_kernels_avx2};
 #else
 typedef int home__avx2_unavailable; /* ISO C forbids an empty translation unit */

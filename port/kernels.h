@@ -41,6 +41,11 @@ typedef struct home__kernels {
      *   out[x] = (sum over v, u < ds of src[v*stride + ds*x + u] + ds*ds/2) / (ds*ds),
      * x in [0, out_w). */
     void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
+    /* Hough extremum candidates: the indices i in [1, n - 1), increasing, where mid[i] > 0 and
+     * above all eight neighbours in up, mid, down at i - 1 .. i + 1, or mid[i] < 0 and below
+     * them all, into idx; returns how many (comparisons only: exact in every backend). */
+    int (*extremum_candidates)(const float *up, const float *mid, const float *down, int n,
+                               int *idx);
     /* the photometric refinement's and the stabiliser's kernels of the same backend */
     const struct home__refine_kernels *refine;
     const struct home__stab_kernels *stab;
@@ -57,7 +62,22 @@ void home__smooth_row_sse(const float *in, float *out, int n, const float *taps,
 void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
                            int radius);
 void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
+int home__extremum_candidates_sse(const float *up, const float *mid, const float *down, int n,
+                                  int *idx);
 #endif
+
+/* The reference test of extremum_candidates at one index (scalar kernel and SIMD tails). */
+static inline int home__is_extremum(const float *up, const float *mid, const float *down, int i)
+{
+    const float v = mid[i];
+    if (v > 0.0f)
+        return v > mid[i - 1] && v > mid[i + 1] && v > up[i - 1] && v > up[i] && v > up[i + 1] &&
+               v > down[i - 1] && v > down[i] && v > down[i + 1];
+    if (v < 0.0f)
+        return v < mid[i - 1] && v < mid[i + 1] && v < up[i - 1] && v < up[i] && v < up[i + 1] &&
+               v < down[i - 1] && v < down[i] && v < down[i + 1];
+    return 0;
+}
 #if defined(__x86_64__) && !defined(HOME_NO_AVX2)
 /* port/avx2.c is compiled with -mavx2 and used only when the CPU reports AVX2 */
 #define HOME__HAVE_AVX2 1

@@ -109,8 +109,39 @@ static void box_down_neon(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t 
     if (x < out_w) home__kernels_scalar.box_down(src + ds * x, stride, ds, out + x, out_w - x);
 }
 
+/* Four bins per step as in the SSE2 kernel; "any lane set" by a pairwise max (armv7 has no
+ * across-vector reduction). */
+static int extremum_candidates_neon(const float *up, const float *mid, const float *down, int n,
+                                    int *idx)
+{
+    const float32x4_t zero = vdupq_n_f32(0.0f);
+    int i, count = 0, lane;
+    for (i = 1; i + 4 <= n - 1; i += 4) {
+        float32x4_t v = vld1q_f32(mid + i);
+        float32x4_t a = vld1q_f32(up + i - 1), b = vld1q_f32(up + i), c = vld1q_f32(up + i + 1);
+        float32x4_t d = vld1q_f32(mid + i - 1), e = vld1q_f32(mid + i + 1);
+        float32x4_t f = vld1q_f32(down + i - 1), g = vld1q_f32(down + i), h = vld1q_f32(down + i + 1);
+        float32x4_t hi = vmaxq_f32(vmaxq_f32(vmaxq_f32(a, b), vmaxq_f32(c, d)),
+                                   vmaxq_f32(vmaxq_f32(e, f), vmaxq_f32(g, h)));
+        float32x4_t lo = vminq_f32(vminq_f32(vminq_f32(a, b), vminq_f32(c, d)),
+                                   vminq_f32(vminq_f32(e, f), vminq_f32(g, h)));
+        uint32x4_t m = vorrq_u32(vandq_u32(vcgtq_f32(v, zero), vcgtq_f32(v, hi)),
+                                 vandq_u32(vcltq_f32(v, zero), vcltq_f32(v, lo)));
+        uint32x2_t any = vorr_u32(vget_low_u32(m), vget_high_u32(m));
+        uint32_t bits[4];
+        if (!vget_lane_u32(vpmax_u32(any, any), 0)) continue;
+        vst1q_u32(bits, m);
+        for (lane = 0; lane < 4; lane++)
+            if (bits[lane]) idx[count++] = i + lane;
+    }
+    for (; i < n - 1; i++)
+        if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
+    return count;
+}
+
 const home__kernels home__kernels_neon = {"neon", radon_blocks_neon, nearest2_l1_neon,
                                           smooth_row_neon, smooth_cols_neon, box_down_neon,
+                                          extremum_candidates_neon,
     &home__refine_kernels_neon, &home__stab_kernels_neon};
 #else
 typedef int home__neon_unavailable; /* ISO C forbids an empty translation unit */

@@ -66,6 +66,16 @@ static void box_down_scalar(const uint8_t *src, ptrdiff_t stride, int ds, uint8_
     }
 }
 
+static int extremum_candidates_scalar(const float *up, const float *mid, const float *down, int n,
+                                      int *idx)
+{
+    int i, count = 0;
+    for (i = 1; i < n - 1; i++)
+        if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
+    return count;
+}
+
 const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
                                             smooth_row_scalar, smooth_cols_scalar, box_down_scalar,
+                                            extremum_candidates_scalar,
     &home__refine_kernels_scalar, &home__stab_kernels_scalar};

@@ -120,8 +120,38 @@ void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *o
     if (x < out_w) home__kernels_scalar.box_down(src + ds * x, stride, ds, out + x, out_w - x);
 }
 
+/* Four bins per step: the largest and smallest of the eight neighbours, then the sign test;
+ * most steps have no candidate and cost one movemask. */
+int home__extremum_candidates_sse(const float *up, const float *mid, const float *down, int n,
+                                  int *idx)
+{
+    const __m128 zero = _mm_setzero_ps();
+    int i, count = 0;
+    for (i = 1; i + 4 <= n - 1; i += 4) {
+        __m128 v = _mm_loadu_ps(mid + i);
+        __m128 a = _mm_loadu_ps(up + i - 1), b = _mm_loadu_ps(up + i), c = _mm_loadu_ps(up + i + 1);
+        __m128 d = _mm_loadu_ps(mid + i - 1), e = _mm_loadu_ps(mid + i + 1);
+        __m128 f = _mm_loadu_ps(down + i - 1), g = _mm_loadu_ps(down + i), h = _mm_loadu_ps(down + i + 1);
+        __m128 hi = _mm_max_ps(_mm_max_ps(_mm_max_ps(a, b), _mm_max_ps(c, d)),
+                               _mm_max_ps(_mm_max_ps(e, f), _mm_max_ps(g, h)));
+        __m128 lo = _mm_min_ps(_mm_min_ps(_mm_min_ps(a, b), _mm_min_ps(c, d)),
+                               _mm_min_ps(_mm_min_ps(e, f), _mm_min_ps(g, h)));
+        int mask = _mm_movemask_ps(_mm_or_ps(_mm_and_ps(_mm_cmpgt_ps(v, zero), _mm_cmpgt_ps(v, hi)),
+                                             _mm_and_ps(_mm_cmplt_ps(v, zero), _mm_cmplt_ps(v, lo))));
+        while (mask) {
+            int lane = mask & 1 ? 0 : mask & 2 ? 1 : mask & 4 ? 2 : 3;
+            idx[count++] = i + lane;
+            mask &= mask - 1;
+        }
+    }
+    for (; i < n - 1; i++)
+        if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
+    return count;
+}
+
 const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, home__nearest2_l1_sse,
                                          home__smooth_row_sse, home__smooth_cols_sse, home__box_down_sse,
+                                         home__extremum_candidates_sse,
     &home__refine_kernels_sse, &home__stab_kernels_sse};
 #else
 typedef int home__sse_unavailable; /* ISO C forbids an empty translation unit */

@@ -177,7 +177,7 @@ typedef struct layout {
     int geom_rows, geom_first;        /* raw theta rows cached (0: none) and the first's k */
     int geom_longest, geom_blocks;
     ptrdiff_t img_n_stride, img_t_stride;
-    size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, matches,
+    size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, candidates, matches,
         inliers, slots, refine, total;
     int max_matches;
 } layout;
@@ -269,6 +269,7 @@ static void plan(const home_config *cfg, layout *l)
     l->row_tmp = take(&cur, r_bins * sizeof(float));
     l->heap = take(&cur, 2 * (size_t)cfg->keypoints_per_sign * sizeof(home__candidate));
     l->extrema = take(&cur, r_bins * sizeof(home__extremum));
+    l->candidates = take(&cur, r_bins * sizeof(int));
     l->matches = take(&cur, (size_t)l->max_matches * sizeof(home__match));
     l->inliers = take(&cur, (size_t)l->max_matches * sizeof(int));
     l->slots = take(&cur, 2 * sizeof(home_features));
@@ -355,6 +356,7 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
     ctx->row_tmp = (float *)(void *)(base + l.row_tmp);
     ctx->heap_items = (home__candidate *)(void *)(base + l.heap);
     ctx->row_extrema = (home__extremum *)(void *)(base + l.extrema);
+    ctx->row_candidates = (int *)(void *)(base + l.candidates);
     ctx->matches = (home__match *)(void *)(base + l.matches);
     ctx->max_matches = l.max_matches;
     ctx->inlier_index = (int *)(void *)(base + l.inliers);

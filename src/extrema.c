@@ -71,28 +71,17 @@ int home__heap_sort_desc(home__heap *heap)
     return heap->count;
 }
 
-int home__detect_row(const float *const *rows, int centre, int r_bins, int theta_bins,
-                     home__extremum *out)
+int home__detect_row(const home__kernels *kernels, const float *const *rows, int centre, int r_bins,
+                     int theta_bins, int *candidates, home__extremum *out)
 {
     const float *up = rows[0], *mid = rows[1], *down = rows[2];
-    int i, n = 0;
-    for (i = 1; i < r_bins - 1; i++) {
-        float v = mid[i];
-        int sign;
+    const int n_candidates = kernels->extremum_candidates(up, mid, down, r_bins, candidates);
+    int c, n = 0;
+    for (c = 0; c < n_candidates; c++) {
+        const int i = candidates[c];
+        const float v = mid[i];
+        const int sign = v > 0.0f ? 1 : -1;
         double g_t, g_r, h_tt, h_rr, h_tr, det, step_t, step_r, theta;
-        if (v > 0.0f) {
-            if (!(v > mid[i - 1] && v > mid[i + 1] && v > up[i - 1] && v > up[i] && v > up[i + 1] &&
-                  v > down[i - 1] && v > down[i] && v > down[i + 1]))
-                continue;
-            sign = 1;
-        } else if (v < 0.0f) {
-            if (!(v < mid[i - 1] && v < mid[i + 1] && v < up[i - 1] && v < up[i] && v < up[i + 1] &&
-                  v < down[i - 1] && v < down[i] && v < down[i + 1]))
-                continue;
-            sign = -1;
-        } else {
-            continue;
-        }
         /* central-difference gradient and Hessian; one Newton step */
         g_t = 0.5 * ((double)down[i] - up[i]);
         g_r = 0.5 * ((double)mid[i + 1] - mid[i - 1]);

@@ -101,6 +101,7 @@ struct home_context {
     float *row_tmp;                   /* r_bins scratch */
     home__candidate *heap_items;      /* 2 * keypoints_per_sign */
     home__extremum *row_extrema;      /* r_bins: extrema of one theta row */
+    int *row_candidates;              /* r_bins: their candidate bins (extremum_candidates) */
     home__match *matches;             /* capacity max_matches */
     int max_matches;
     int *inlier_index;                /* max_matches: indices of current inliers */
@@ -151,9 +152,10 @@ int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t ord
 void home__heap_push(home__heap *heap, const home__candidate *cand);
 int home__heap_sort_desc(home__heap *heap);
 /* Scan smoothed row rows[1] (rows[0..2] = centre-1 .. centre+1) for strict extrema with a valid
- * Newton step whose refined theta lies in [0, theta_bins); returns how many were written. */
-int home__detect_row(const float *const *rows, int centre, int r_bins, int theta_bins,
-                     home__extremum *out);
+ * Newton step whose refined theta lies in [0, theta_bins); returns how many were written.
+ * candidates: r_bins ints of scratch. */
+int home__detect_row(const home__kernels *kernels, const float *const *rows, int centre, int r_bins,
+                     int theta_bins, int *candidates, home__extremum *out);
 
 /* describe.c */
 void home__describe_samples(const float *const *rows, int centre, int r_bins, float theta_bin,

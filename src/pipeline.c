@@ -60,7 +60,8 @@ static void on_row(void *user, int j, const float *const *window)
     if (!st->detect || !window[0] || centre < -1 || centre > n_theta) return;
 
     t0 = home__now(ctx);
-    n = home__detect_row(window + 1, centre, r_bins, n_theta, ctx->row_extrema);
+    n = home__detect_row(ctx->kernels, window + 1, centre, r_bins, n_theta, ctx->row_candidates,
+                         ctx->row_extrema);
     t1 = home__now(ctx);
     for (k = 0; k < n; k++) {
         const home__extremum *x = &ctx->row_extrema[k];

@@ -154,6 +154,49 @@ void test_kernels_box_down(void)
     }
 }
 
+/* Extremum candidates: every backend finds exactly the strict, signed 3x3 extrema of the
+ * definition, on rows with plateaus, zeros and both signs, odd lengths and unaligned starts. */
+void test_kernels_extremum_candidates(void)
+{
+    enum { N = 203 };
+    static float rows[3][N + 8];
+    static int want[N], got[N];
+    synth_rng rng;
+    int trial, total = 0;
+    synth_seed(&rng, 41);
+    for (trial = 0; trial < 40; trial++) {
+        const int n = 3 + (trial * 37) % (N - 3), off = trial % 5;
+        const float *up = rows[0] + off, *mid = rows[1] + off, *down = rows[2] + off;
+        int r, i, count, want_n = 0;
+        size_t bi;
+        for (r = 0; r < 3; r++)
+            for (i = 0; i < N + 8; i++) {
+                /* coarse levels make ties and plateaus common; every fifth value is 0 */
+                float v = (float)((int)(synth_uniform(&rng) * 9) - 4);
+                rows[r][i] = i % 5 == 0 ? 0.0f : trial % 3 ? v : v * 0.37f + (float)synth_uniform(&rng);
+            }
+        for (i = 1; i < n - 1; i++) {
+            float v = mid[i];
+            int k, above = 1, below = 1;
+            const float nb[8] = {up[i - 1], up[i], up[i + 1], mid[i - 1], mid[i + 1], down[i - 1], down[i], down[i + 1]};
+            for (k = 0; k < 8; k++) { above &= v > nb[k]; below &= v < nb[k]; }
+            if ((v > 0.0f && above) || (v < 0.0f && below)) want[want_n++] = i;
+        }
+        total += want_n;
+        count = home__kernels_scalar.extremum_candidates(up, mid, down, n, got);
+        CHECK_EQ_INT(count, want_n);
+        CHECK(memcmp(want, got, (size_t)want_n * sizeof *want) == 0);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *kr = home__kernels_for(backends[bi]);
+            if (!kr) continue;
+            count = kr->extremum_candidates(up, mid, down, n, got);
+            CHECK_EQ_INT(count, want_n);
+            CHECK(memcmp(want, got, (size_t)want_n * sizeof *want) == 0);
+        }
+    }
+    CHECK(total > 100);
+}
+
 void test_backends_identical_output(void)
 {
     /* the whole registration is bit-identical on every compiled backend */
