@@ -37,6 +37,8 @@ Metrics, all on luma, computed the same way for every method from its output fra
              (where a two-pass method, which sees the whole clip, can slow the output down)
 Usage: python3 bench/stab/compare.py [--quick | --smoke] [--build build] [--frames N] [--out DIR]
          [--methods home-stab,home-stab la15,vidstab,deshake] [--stab-args "--theta-bins 64"]
+         [--repeat N]   (fps columns from the fastest of N runs per method and clip: on a shared
+                         machine single runs vary by 10-50 %)
 """
 import argparse
 import glob
@@ -292,6 +294,7 @@ def main():
     ap.add_argument("--methods", default="home-stab,home-stab la15,vidstab,deshake",
                     help="comma-separated subset of the methods to run")
     ap.add_argument("--stab-args", default="", help="extra home-stab options (e.g. --theta-bins 64)")
+    ap.add_argument("--repeat", type=int, default=1, help="run each method N times, fps from the fastest")
     args = ap.parse_args()
     build = REPO / args.build
     work = Path(args.out) if args.out else build / "bench-stab"
@@ -340,8 +343,11 @@ def main():
             input_jitter.setdefault(cat, []).append(jitter(components(truth)))
             for mname, cmds in methods.items():
                 o = work / ("%s_%s.y4m" % (stem, mname.replace(" ", "_")))
-                times = [run(cmd) for cmd in cmds(str(c), str(o))]
-                wall, cpu = sum(t[0] for t in times), sum(t[1] for t in times)
+                wall = cpu = float("inf")
+                for _ in range(max(args.repeat, 1)):
+                    times = [run(cmd) for cmd in cmds(str(c), str(o))]
+                    wall = min(wall, sum(t[0] for t in times))
+                    cpu = min(cpu, sum(t[1] for t in times))
                 outs = read_y4m_luma(o)
                 if len(outs) != len(ins):
                     sys.exit("%s wrote %d frames of %d" % (mname, len(outs), len(ins)))
