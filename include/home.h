@@ -106,8 +106,8 @@ typedef struct home_config {
 int home_default_config(home_config *cfg, int width, int height);
 
 /* Defaults for consecutive video frames (small motion between them, registered against cached
- * features): the Hough transform of a box-downscaled frame about 160 px wide with 160 theta
- * bins, 500 keypoints per sign, a 10-bin (11 degree) theta window, a first threshold of 8;
+ * features): the Hough transform of a box-downscaled frame about 160 px wide with 120 theta
+ * bins, 500 keypoints per sign, an 8-bin (12 degree) theta window, a first threshold of 8;
  * the photometric refinement at full resolution (2048 template points) restores sub-pixel
  * precision. Motion between
  * the frames should stay under ~30 px at the corners (README, Speed). */
