@@ -178,6 +178,7 @@ typedef struct layout {
     size_t geom_bytes;                /* one record's arrays */
     int geom_rows, geom_first;        /* raw theta rows cached (0: none) and the first's k */
     int geom_longest, geom_blocks;
+    size_t geom_intercepts;
     ptrdiff_t img_n_stride, img_t_stride;
     size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, candidates, matches,
         inliers, slots, refine, total;
@@ -194,15 +195,16 @@ static size_t take(size_t *cursor, size_t bytes)
 /* Bytes of one theta geometry record's arrays, each on a 16-byte boundary. */
 static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
 
-static size_t geom_record_bytes(int longest, int blocks, size_t r_bins)
+static size_t geom_record_bytes(int longest, int blocks, size_t intercepts, size_t r_bins)
 {
     return align16((size_t)longest * sizeof(int16_t)) + 2 * align16((size_t)blocks * sizeof(int16_t)) +
-           align16(((size_t)longest + 4) * sizeof(int32_t)) + align16(r_bins * sizeof(int16_t)) +
-           align16(r_bins * sizeof(float));
+           align16(((size_t)longest + 4) * sizeof(int32_t)) + 2 * align16(intercepts * sizeof(int16_t)) +
+           align16(r_bins * sizeof(int16_t)) + align16(r_bins * sizeof(float));
 }
 
 /* Point a record's arrays into mem (geom_record_bytes of it). */
-static void carve_geom(home__theta_geom *g, unsigned char *mem, int longest, int blocks, size_t r_bins)
+static void carve_geom(home__theta_geom *g, unsigned char *mem, int longest, int blocks,
+                       size_t intercepts, size_t r_bins)
 {
     g->shift = (int16_t *)(void *)mem;
     mem += align16((size_t)longest * sizeof(int16_t));
@@ -212,6 +214,10 @@ static void carve_geom(home__theta_geom *g, unsigned char *mem, int longest, int
     mem += align16((size_t)blocks * sizeof(int16_t));
     g->first_row = (int32_t *)(void *)mem;
     mem += align16(((size_t)longest + 4) * sizeof(int32_t));
+    g->entry = (int16_t *)(void *)mem;
+    mem += align16(intercepts * sizeof(int16_t));
+    g->after = (int16_t *)(void *)mem;
+    mem += align16(intercepts * sizeof(int16_t));
     g->res_k = (int16_t *)(void *)mem;
     mem += align16(r_bins * sizeof(int16_t));
     g->res_f = (float *)(void *)mem;
@@ -248,7 +254,8 @@ static void plan(const home_config *cfg, layout *l)
         l->img_t = take(&cur, w * (size_t)l->img_t_stride);
         l->geom_longest = (int)longest;
         l->geom_blocks = (int)(intercepts / HOME__RADON_BLOCK + 1);
-        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, r_bins);
+        l->geom_intercepts = w + h + 8; /* a row's intercepts, without the kernel's block slack */
+        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, intercepts, r_bins);
         {
             int rows;
             home__hough_raw_rows(cfg, (int)radius, &l->geom_first, &rows);
@@ -261,7 +268,7 @@ static void plan(const home_config *cfg, layout *l)
             }
         }
         l->line_sum = take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(int32_t));
-        l->edge_prefix = take(&cur, 2 * (longest + 1) * sizeof(int32_t));
+        l->edge_prefix = take(&cur, 4 * 2 * (longest + 1) * sizeof(int32_t));
         l->line_j = take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(float));
     }
     l->acc_x = take(&cur, r_bins * sizeof(int32_t));
@@ -339,13 +346,13 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
             ctx->geom = (home__theta_geom *)(void *)(base + l.geom);
             for (k = 0; k < l.geom_rows; k++) {
                 carve_geom(&ctx->geom[k], arrays + (size_t)k * l.geom_bytes, l.geom_longest,
-                           l.geom_blocks, (size_t)ctx->r_bins);
+                           l.geom_blocks, l.geom_intercepts, (size_t)ctx->r_bins);
                 home__theta_geometry(ctx, (l.geom_first + k) * HOME__PI / cfg->theta_bins, &ctx->geom[k]);
             }
         } else {
             ctx->geom = NULL;
             carve_geom(&ctx->geom_scratch, base + l.geom_scratch, l.geom_longest, l.geom_blocks,
-                       (size_t)ctx->r_bins);
+                       l.geom_intercepts, (size_t)ctx->r_bins);
         }
         ctx->line_sum = (int32_t *)(void *)(base + l.line_sum);
         ctx->edge_prefix = (int32_t *)(void *)(base + l.edge_prefix);

@@ -69,6 +69,8 @@ typedef struct home__theta_geom {
     float d_scale, end_scale;         /* J = d_scale (S(j+1) - S(j-1)) + end_scale [I] */
     int16_t *shift, *row_lo, *row_hi; /* per-row shear, per-block row ranges */
     int32_t *first_row;               /* first row whose shift reaches a value */
+    int16_t *entry, *after;           /* per intercept: first row inside the image, and the row
+                                         after its last */
     int16_t *res_k;                   /* r bin i (from i_lo): intercept index k and weight */
     float *res_f;                     /*   f of line[k] + f (line[k+1] - line[k]) */
 } home__theta_geom;
@@ -93,7 +95,8 @@ struct home_context {
     home__theta_geom *geom;           /* FAST: every raw theta row's geometry, or NULL */
     home__theta_geom geom_scratch;    /* FAST: one row's, when not cached */
     int32_t *line_sum;                /* FAST: line sums over the intercept range */
-    int32_t *edge_prefix;             /* FAST: prefix sums of the first and last column */
+    int32_t *edge_prefix;             /* FAST: prefix sums of the first and last column, per
+                                         theta family and direction (src/hough.c) */
     float *line_j;                    /* FAST: J over the intercept range */
     int32_t *acc_x, *acc_y;           /* r_bins: line sums of one theta row */
     float *raw_rows;                  /* ring of (2*radius+1) r-smoothed rows */

@@ -44,6 +44,8 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
 /* Copy the image (box-downscaled when hough_downscale is 2 or 4) into the zero-padded buffers
  * (HOME__RADON_BLOCK columns each side) used by the shear-and-add kernel: img_n as is, img_t
  * transposed from it. */
+static void prefix_edges(home_context *ctx);
+
 static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
 {
     const int width = ctx->hough_w, height = ctx->hough_h, pad = HOME__RADON_BLOCK;
@@ -68,6 +70,47 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
         uint8_t *dst = ctx->img_t + pad + y;
         for (x = 0; x < width; x++) dst[(ptrdiff_t)x * ctx->img_t_stride] = src[x];
     }
+    prefix_edges(ctx);
+}
+
+/* The image a theta family reads, in processing order: its column 0 of row 0, the row step,
+ * rows and columns. vertical: lines within 45 degrees of the columns (the image itself), else
+ * the transposed image; flip: rows taken bottom to top. */
+static const uint8_t *family_image(const home_context *ctx, int vertical, int flip, ptrdiff_t *stride,
+                                   int *rows, int *cols)
+{
+    const ptrdiff_t img_stride = vertical ? ctx->img_n_stride : ctx->img_t_stride;
+    const uint8_t *img = (vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK;
+    *rows = vertical ? ctx->hough_h : ctx->hough_w;
+    *cols = vertical ? ctx->hough_w : ctx->hough_h;
+    *stride = flip ? -img_stride : img_stride;
+    return flip ? img + (ptrdiff_t)(*rows - 1) * img_stride : img;
+}
+
+/* Prefix sums of the first and last column of a family's rows in processing order (the
+ * replicated border's line sums), per frame for all four (vertical, flip): left, then right. */
+static int32_t *edge_prefix(const home_context *ctx, int vertical, int flip)
+{
+    const int longest = ctx->hough_w > ctx->hough_h ? ctx->hough_w : ctx->hough_h;
+    return ctx->edge_prefix + (ptrdiff_t)(2 * vertical + flip) * 2 * (longest + 1);
+}
+
+static void prefix_edges(home_context *ctx)
+{
+    const int longest = ctx->hough_w > ctx->hough_h ? ctx->hough_w : ctx->hough_h;
+    int vertical, flip, p, rows, cols;
+    ptrdiff_t stride;
+    for (vertical = 0; vertical < 2; vertical++)
+        for (flip = 0; flip < 2; flip++) {
+            const uint8_t *base = family_image(ctx, vertical, flip, &stride, &rows, &cols);
+            int32_t *left = edge_prefix(ctx, vertical, flip), *right = left + longest + 1;
+            left[0] = right[0] = 0;
+            for (p = 0; p < rows; p++) {
+                const uint8_t *row = base + (ptrdiff_t)p * stride;
+                left[p + 1] = left[p] + row[0];
+                right[p + 1] = right[p] + row[cols - 1];
+            }
+        }
 }
 
 /* first row (in processing order) whose shift is >= v; shifts are nondecreasing */
@@ -123,6 +166,17 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
         g->row_lo[blk] = (int16_t)first_row_at(g, -jb - (HOME__RADON_BLOCK - 1), rows);
         g->row_hi[blk] = (int16_t)(first_row_at(g, cols - jb, rows) - 1);
     }
+    {
+        /* each intercept's entry row (rows before it lie left of the image) and the row after
+         * its exit (from there on right of it); lines through every row: 0 and rows */
+        const int span = s_max - s_min + 1;
+        int i;
+        for (i = 0; i < n; i++) {
+            const int j = j0 + i, v_entry = -j - s_min, v_after = cols - j - s_min;
+            g->entry[i] = (int16_t)g->first_row[v_entry < 0 ? 0 : v_entry > span ? span : v_entry];
+            g->after[i] = (int16_t)g->first_row[v_after > span ? span : v_after];
+        }
+    }
     g->d_scale = (float)(inv_abs_a / a);
     g->end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
     {
@@ -160,49 +214,35 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
 /* One theta row of J, unsmoothed, on the uniform r axis. */
 static void fast_theta_row(home_context *ctx, const home__theta_geom *g, float *out)
 {
-    const int rows = g->vertical ? ctx->hough_h : ctx->hough_w;
-    const int cols = g->vertical ? ctx->hough_w : ctx->hough_h;
-    const ptrdiff_t img_stride = g->vertical ? ctx->img_n_stride : ctx->img_t_stride;
-    const uint8_t *img = (g->vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK; /* column 0 */
-    const uint8_t *base = g->flip ? img + (ptrdiff_t)(rows - 1) * img_stride : img;
-    const ptrdiff_t stride = g->flip ? -img_stride : img_stride;
+    const int longest = ctx->hough_w > ctx->hough_h ? ctx->hough_w : ctx->hough_h;
     const int16_t *shift = g->shift;
     const int s_min = g->s_min, s_max = g->s_max, j0 = g->j0, n = g->n;
-    int32_t *left = ctx->edge_prefix, *right = ctx->edge_prefix + rows + 1;
+    const int32_t *left = edge_prefix(ctx, g->vertical, g->flip), *right = left + longest + 1;
     int32_t *sum = ctx->line_sum;
     float *line = ctx->line_j;
-    int p, j, i;
+    ptrdiff_t stride;
+    int rows, cols, j, i;
+    const uint8_t *base = family_image(ctx, g->vertical, g->flip, &stride, &rows, &cols);
 
     ctx->kernels->radon_blocks(base, stride, shift, j0, g->n_blocks, g->row_lo, g->row_hi, sum);
-
-    /* prefix sums of the first and last column in processing order (the replicated border) */
-    left[0] = right[0] = 0;
-    for (p = 0; p < rows; p++) {
-        const uint8_t *row = base + (ptrdiff_t)p * stride;
-        left[p + 1] = left[p] + row[0];
-        right[p + 1] = right[p] + row[cols - 1];
-    }
     {
-        const int32_t *fr = g->first_row, right_total = right[rows];
-        const int span = s_max - s_min + 1;
+        const int32_t right_total = right[rows];
         /* lines through every row (entry 0, exit rows - 1): no border term, and their end
          * pixels lie on two contiguous rows */
         const int mid_lo = -s_min - j0, mid_hi = cols - s_max - j0; /* [mid_lo, mid_hi) */
         const uint8_t *first_row_px = base + shift[0];
         const uint8_t *last_row_px = base + (ptrdiff_t)(rows - 1) * stride + shift[rows - 1];
         for (i = 0; i < n; i++) {
-            int v_entry, v_after, entry, after;
-            j = j0 + i;
+            int entry, after;
             if (i == mid_lo && mid_lo < mid_hi) {
                 for (; i < mid_hi; i++)
                     line[i] = (float)(last_row_px[j0 + i] - first_row_px[j0 + i]);
                 if (i >= n) break;
-                j = j0 + i;
             }
-            v_entry = -j - s_min;                   /* rows before the entry: left of the image */
-            v_after = cols - j - s_min;             /* rows from `after` on: right of it */
-            entry = fr[v_entry < 0 ? 0 : v_entry > span ? span : v_entry];
-            after = fr[v_after > span ? span : v_after];
+            j = j0 + i;
+            entry = g->entry[i];
+            after = g->after[i];
+            /* the replicated border's share of the line: the rows outside the image */
             sum[i] += left[entry] + right_total - right[after];
             if (entry < after) {
                 int first_value = base[(ptrdiff_t)entry * stride + j + shift[entry]];

@@ -59,7 +59,7 @@ void test_hough_geometry_cache(void)
     static union { unsigned char b[(2u << 20) + 64]; double d; } storage;
     static uint8_t a[640 * 360];
     static home_features cached, per_frame;
-    static int16_t shift[4096], row_lo[256], row_hi[256], res_k[4 * 4096];
+    static int16_t shift[4096], row_lo[256], row_hi[256], res_k[4 * 4096], entry[2 * 4096 + 8], after[2 * 4096 + 8];
     static int32_t first_row[4096 + 8];
     static float res_f[4 * 4096];
     unsigned char *mem = (unsigned char *)(((uintptr_t)storage.b + 63) & ~(uintptr_t)63);
@@ -76,7 +76,7 @@ void test_hough_geometry_cache(void)
     CHECK_EQ_INT(home_extract(ctx, a, 640, &cached), HOME_OK);
     /* the cache still holds what home__theta_geometry computes */
     fresh.shift = shift; fresh.row_lo = row_lo; fresh.row_hi = row_hi; fresh.first_row = first_row;
-    fresh.res_k = res_k; fresh.res_f = res_f;
+    fresh.res_k = res_k; fresh.res_f = res_f; fresh.entry = entry; fresh.after = after;
     home__hough_raw_rows(&ctx->cfg, ctx->smooth_radius, &first, &rows);
     for (k = 0; k < rows; k++) {
         const home__theta_geom *g = &ctx->geom[k];
@@ -91,6 +91,8 @@ void test_hough_geometry_cache(void)
         bad += memcmp(fresh.row_lo, g->row_lo, (size_t)g->n_blocks * sizeof *row_lo) != 0;
         bad += memcmp(fresh.row_hi, g->row_hi, (size_t)g->n_blocks * sizeof *row_hi) != 0;
         bad += memcmp(fresh.res_k, g->res_k, (size_t)n_res * sizeof *res_k) != 0;
+        bad += memcmp(fresh.entry, g->entry, (size_t)g->n * sizeof *entry) != 0;
+        bad += memcmp(fresh.after, g->after, (size_t)g->n * sizeof *after) != 0;
         bad += memcmp(fresh.res_f, g->res_f, (size_t)n_res * sizeof *res_f) != 0;
     }
     CHECK_EQ_INT(bad, 0);
