@@ -364,17 +364,20 @@ static void level_matrix(const solver *s, const double *hn, int level, float *m)
 }
 
 /* Robust scale: 1.4826 * median |r| over the valid points, from a histogram. */
-static double robust_sigma(const float *img_b, const int16_t *t, int n, double alpha, double beta)
+static double robust_sigma(const float *img_b, const int16_t *t, int n, double alpha, double beta,
+                           int32_t *bins)
 {
     const float a = (float)alpha, b = (float)beta;
-    int hist[HIST_BINS + 1], i, count = 0, half, acc = 0;
+    int hist[HIST_BINS + 2], i, count, half, acc = 0;
     memset(hist, 0, sizeof hist);
+    /* bins first (element-wise: vectorised), then the histogram; invalid points in a spare bin */
     for (i = 0; i < n; i++) {
         const float r = fabsf(a * img_b[i] + b - (float)t[i]) * 8.0f;
-        const int valid = img_b[i] >= 0.0f;
-        hist[r < (float)HIST_BINS ? (int)r : HIST_BINS] += valid;
-        count += valid;
+        const int bin = r < (float)HIST_BINS ? (int)r : HIST_BINS;
+        bins[i] = img_b[i] >= 0.0f ? bin : HIST_BINS + 1;
     }
+    for (i = 0; i < n; i++) hist[bins[i]]++;
+    count = n - hist[HIST_BINS + 1];
     if (!count) return SIGMA_FLOOR;
     half = (count + 1) / 2;
     for (i = 0; i <= HIST_BINS; i++) {
@@ -476,7 +479,7 @@ static int iterate(solver *s, int level, double *step_px)
     level_matrix(s, s->hn, level, m);
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
                       st->h[level], s->img_b);
-    s->sigma = robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta);
+    s->sigma = robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta, (int32_t *)(void *)s->wt);
     valid = fit_photometric(s, tp, s->img_b, NULL, s->sigma, s->res, s->wt);
     if (valid < MIN_POINTS) return 0;
     aff[0] = (float)(sc / s->f);
@@ -667,7 +670,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
         s.alpha = 1.0;
         s.beta = 0.0;
         fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
-        sigma0 = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta);
+        sigma0 = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta, (int32_t *)(void *)s.wt);
         e0 = photometric_error(&s, s.img_b, s.img_b2, sigma0, &zncc0);
         e1 = photometric_error(&s, s.img_b2, s.img_b, sigma0, &zncc1);
     }
