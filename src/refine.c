@@ -292,7 +292,8 @@ typedef struct solver {
     double jtj[64];                     /* last weighted normal matrix (normalised units) */
     float acc[N_ACC * LANES];           /* per-lane sums of the normal equations */
     int hessian_level;                  /* level whose J^T W J acc holds (-1: none yet) */
-    double resid_var;                   /* weighted residual variance of the last iteration */
+    double resid_var;                   /* weighted residual variance of the last iteration
+                                           (set once the finest level converged) */
     double split_px;                    /* split-half disagreement of the last finest step */
     int finest;                         /* level the estimate ends at */
     float *img_b, *img_b2, *res, *wt;   /* per-point scratch */
@@ -475,7 +476,7 @@ static int iterate(solver *s, int level, double *step_px)
     const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
     const double k = s->f / (2.0 * sc);  /* template gradient: 2x central difference per level px */
     float m[9], aff[3], *acc = s->acc;
-    double a[64], g[8], dp[9], hd[9], hdi[9], t[9], sum_w = 0, sum_wr2 = 0;
+    double a[64], g[8], dp[9], hd[9], hdi[9], t[9];
     int i, p, valid;
 
     level_matrix(s, s->hn, level, m);
@@ -510,11 +511,6 @@ static int iterate(solver *s, int level, double *step_px)
             s->split_px = INFINITY;
         }
     }
-    for (i = 0; i < tp->n; i++) {
-        sum_w += s->wt[i];
-        sum_wr2 += (double)s->wt[i] * s->res[i] * s->res[i];
-    }
-    s->resid_var = sum_w > 8 ? sum_wr2 / (sum_w - 8) : sum_wr2;
     if (!home__solve_spd8(a, g)) return 0;
     for (p = 0; p < 8; p++) dp[p] = g[p];
     *step_px = corner_step_px(s, dp);
@@ -528,6 +524,20 @@ static int iterate(solver *s, int level, double *step_px)
         if (!isfinite(t[i])) return 0;
     memcpy(s->hn, t, sizeof t);
     return 1;
+}
+
+/* Weighted residual variance of the last iteration (its weights and residuals are still in the
+ * scratch), for the Fisher covariance below. */
+static double residual_variance(const solver *s)
+{
+    const home__refine_points *tp = &s->tpl[s->finest];
+    double sum_w = 0, sum_wr2 = 0;
+    int i;
+    for (i = 0; i < tp->n; i++) {
+        sum_w += s->wt[i];
+        sum_wr2 += (double)s->wt[i] * s->res[i] * s->res[i];
+    }
+    return sum_w > 8 ? sum_wr2 / (sum_w - 8) : sum_wr2;
 }
 
 /* Predicted standard deviation of the worst corner, px: sqrt(J_c (sigma^2 A^-1) J_c^T). */
@@ -650,6 +660,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     result->refine_iterations = iterations;
     if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return; }
     to_pixels(&s, s.hn, h1);
+    s.resid_var = residual_variance(&s);
     if (corner_std_px(&s) > MAX_CORNER_STD_PX || !(s.split_px <= MAX_CORNER_STD_PX)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return;
