@@ -1,102 +1,157 @@
 /* AVX2-machine warp row kernel (compiled with -mavx2, used when the CPU has AVX2): sixteen output
- * pixels per step, two groups of eight in the two 128-bit lanes. Where a group's source pairs lie
- * in one 16-byte window (dx in [0, 2): every stabilisation warp) they are gathered by one load
- * per row and a byte shuffle (pshufb) instead of sixteen pinsrw; the blend is port/stab_x86.h's
- * at twice the width. Other groups take the SSE2 kernel's steps. Same bytes as the reference. */
+ * pixels per step, two groups of eight in the two 128-bit lanes. While the row of the warp stays
+ * on one source row pair and dx is in [0, 2) (every stabilisation warp), each group's pairs lie
+ * in a 16-byte window per row: one load per row and lane and a byte shuffle (pshufb) whose
+ * control comes from the x fractions alone (pixel k's pair is at window offset
+ * (k dx) >> 16 plus the carry of its fraction). The blend is pmaddubsw (horizontal, on pixels
+ * offset by -128 so that the weight 128 fits a byte) and pmaddwd (vertical). Other groups gather
+ * per pixel (port/stab_x86.h). Same bytes as the reference. */
 #include "kernels.h"
 #include "stab_kernels.h"
 #if defined(HOME__HAVE_AVX2) && defined(__AVX2__)
 #include "stab_x86.h"
 #include <immintrin.h>
 
-/* port/stab_x86.h's blend for sixteen pixels (lanes: pixels 0-7 | 8-15) into dst[0..15] */
-static void blend16(__m256i top, __m256i bot, __m256i frac_x, __m256i frac_y, uint8_t *dst)
+/* Sixteen pixels (lanes: pixels 0-7 | 8-15) whose pairs sit as p0 | p1 << 8 in the 16-bit lanes
+ * of top and bottom, blended with the reference's 7-bit weights into dst[0..15], its bytes
+ * exactly: with fx = HOME__WARP_WEIGHT of the x fraction, the bytes (128 - fx, fx) times the
+ * pairs less 128 give top - 16384 (|products| <= 2^14: no saturation), and
+ * (top - 2^14) (128 - fy) + (bot - 2^14) fy = R - 2^21, so the result is (that + 2^21 + 2^13) >> 14. */
+static inline void blend16(__m256i top, __m256i bot, __m256i frac_x, __m256i frac_y, uint8_t *dst)
 {
-    const __m256i zero = _mm256_setzero_si256(), c128 = _mm256_set1_epi16(128), low = _mm256_set1_epi16(0xff);
-    const __m256i fx = _mm256_avg_epu16(_mm256_srli_epi16(frac_x, 8), zero), gx = _mm256_sub_epi16(c128, fx);
+    const __m256i zero = _mm256_setzero_si256(), c128 = _mm256_set1_epi16(128), flip = _mm256_set1_epi8(-128);
+    /* HOME__WARP_WEIGHT of 16-bit fractions: (f + 256) >> 9 = ((f >> 8) + 1) >> 1, pavgw with 0 */
+    const __m256i fx = _mm256_avg_epu16(_mm256_srli_epi16(frac_x, 8), zero);
+    const __m256i wx = _mm256_add_epi16(_mm256_mullo_epi16(fx, _mm256_set1_epi16(255)), c128);   /* 128 - fx | fx << 8 */
     const __m256i fy = _mm256_avg_epu16(_mm256_srli_epi16(frac_y, 8), zero), gy = _mm256_sub_epi16(c128, fy);
-    const __m256i t = _mm256_add_epi16(_mm256_mullo_epi16(_mm256_and_si256(top, low), gx),
-                                       _mm256_mullo_epi16(_mm256_srli_epi16(top, 8), fx));
-    const __m256i b = _mm256_add_epi16(_mm256_mullo_epi16(_mm256_and_si256(bot, low), gx),
-                                       _mm256_mullo_epi16(_mm256_srli_epi16(bot, 8), fx));
+    const __m256i t = _mm256_maddubs_epi16(wx, _mm256_xor_si256(top, flip));
+    const __m256i b = _mm256_maddubs_epi16(wx, _mm256_xor_si256(bot, flip));
+    const __m256i round = _mm256_set1_epi32((1 << 21) + (1 << 13));
     __m256i r0 = _mm256_madd_epi16(_mm256_unpacklo_epi16(t, b), _mm256_unpacklo_epi16(gy, fy));
     __m256i r1 = _mm256_madd_epi16(_mm256_unpackhi_epi16(t, b), _mm256_unpackhi_epi16(gy, fy));
-    r0 = _mm256_srli_epi32(_mm256_add_epi32(r0, _mm256_set1_epi32(8192)), 14);
-    r1 = _mm256_srli_epi32(_mm256_add_epi32(r1, _mm256_set1_epi32(8192)), 14);
+    r0 = _mm256_srli_epi32(_mm256_add_epi32(r0, round), 14);
+    r1 = _mm256_srli_epi32(_mm256_add_epi32(r1, round), 14);
     r0 = _mm256_packus_epi16(_mm256_packs_epi32(r0, r1), zero);   /* lanes: bytes 0-7 | 8-15 */
     _mm_storeu_si128((__m128i *)(void *)dst, _mm256_castsi256_si128(_mm256_permute4x64_epi64(r0, 0x08)));
 }
 
-/* one 16-byte window per row and lane: lane j's source pairs start at base[j] */
-static __m256i window(const uint8_t *row, int32_t base0, int32_t base1)
+/* one 16-byte window per row and lane: lane j's window starts at column base_j */
+static inline __m256i window(const uint8_t *row, uint32_t base0, uint32_t base1)
 {
     return _mm256_inserti128_si256(_mm256_castsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)(row + base0))),
                                    _mm_loadu_si128((const __m128i *)(const void *)(row + base1)), 1);
 }
 
-/* the SSE2 kernel's step for pixels x, x + dx, ... x + 7 dx */
-static void group8(const uint8_t *src, ptrdiff_t stride, int32_t x, int32_t y, int32_t dx,
-                   int32_t dy, __m128i frac_x, __m128i frac_y, uint8_t *dst)
+/* sixteen pixels from (x, y) that the shuffle path does not take (a group crossing a source row,
+ * a window past the row's end, dx outside [0, 2)): each group of eight from its row pair or, when
+ * it crosses a source row, per pixel. Kept out of line: the fast loop keeps its registers. */
+__attribute__((noinline)) static void gather16(const uint8_t *src, ptrdiff_t stride, uint32_t x, uint32_t y,
+                                               int32_t dx, int32_t dy, __m256i frac_x, __m256i frac_y, uint8_t *dst)
 {
-    __m128i top, bot;
-    if ((y >> HOME__WARP_FRAC_BITS) == ((y + 7 * dy) >> HOME__WARP_FRAC_BITS))
-        home__stab_gather8(src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride, stride, (uint32_t)x, dx, &top, &bot);
-    else
-        home__stab_gather8_rows(src, stride, (uint32_t)x, y, dx, dy, &top, &bot);
-    home__stab_blend8(top, bot, frac_x, frac_y, dst);
+    __m128i t0, b0, t1, b1;
+    home__stab_gather8_any(src, stride, x, y, dx, dy, &t0, &b0);
+    home__stab_gather8_any(src, stride, x + 8u * (uint32_t)dx, y + 8u * (uint32_t)dy, dx, dy, &t1, &b1);
+    blend16(_mm256_inserti128_si256(_mm256_castsi128_si256(t0), t1, 1),
+            _mm256_inserti128_si256(_mm256_castsi128_si256(b0), b1, 1), frac_x, frac_y, dst);
 }
 
 static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                           int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
     const __m256i step_x = _mm256_set1_epi16(home__stab_low16(0, dx, 16)), step_y = _mm256_set1_epi16(home__stab_low16(0, dy, 16));
-    const __m256i pair = _mm256_set1_epi16(0x0100);
-    __m256i frac_x, frac_y, off0, off1;
-    int32_t x = x0, y = y0;
-    int i = 0;
+    const uint32_t dx8 = 8u * (uint32_t)dx, dx16 = 16u * (uint32_t)dx, dy15 = 15u * (uint32_t)dy, dy16 = 16u * (uint32_t)dy;
+    /* the shuffle path: the pairs of a group of eight within 16 bytes (dx in [0, 2): pixel 7's
+     * pair at offset <= 13 + 1) and the windows inside the row (x8 >> 16 <= w - 16, x8 = x + 8 dx
+     * the second group's first pixel: x8 < xlim); x grows, so a prefix of the groups */
+    const uint32_t xlim = dx >= 0 && dx < (2 << HOME__WARP_FRAC_BITS) && w >= 16 ? (uint32_t)(w - 15) << HOME__WARP_FRAC_BITS : 0;
+    __m256i frac_x, frac_y, edge, pairs;
+    const uint8_t *row;
+    uint8_t *d = dst, *const end = dst + (n & ~15), *fast_end;
+    uint32_t x = (uint32_t)x0, lo, yrel;   /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
+    const int cross = dy > -4096 && dy < 4096;   /* 15 |dy| < 2^16: a group spans at most two source rows */
+    int k;
     if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
+    {
+        /* pixel k of a group (first pixel's fraction f) has its pair at window offset D_k + carry,
+         * D_k = (k dx) >> 16, carry = f + (k dx & 0xffff) >= 2^16: its own fraction below
+         * e_k = k dx & 0xffff. The control bytes (D_k + carry, D_k + 1 + carry) are
+         * pairs + (D_k + 1) 0x0101 less the bytes of the mask "fraction >= e_k" (all ones). */
+        short dk[8];
+        const uint32_t x8 = x + dx8, groups = (uint32_t)n / 16;
+        uint32_t fast = 0;
+        for (k = 0; k < 8; k++) dk[k] = (short)(((uint32_t)k * (uint32_t)dx >> HOME__WARP_FRAC_BITS & 0xff) * 257 + 513);
+        pairs = _mm256_broadcastsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)dk));
+        edge = _mm256_broadcastsi128_si256(home__stab_fractions(0, dx));
+        if (x8 < xlim) fast = dx16 ? (xlim - 1 - x8) / dx16 + 1 : groups;
+        fast_end = dst + 16 * (ptrdiff_t)(fast < groups ? fast : groups);
+    }
     /* pixels 0-7 | 8-15 (the start wraps like the fractions: rows shorter than 16 never use it) */
     frac_x = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions((uint32_t)x0, dx)),
-                                     home__stab_fractions((uint32_t)x0 + 8u * (uint32_t)dx, dx), 1);
+                                     home__stab_fractions((uint32_t)x0 + dx8, dx), 1);
     frac_y = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions((uint32_t)y0, dy)),
                                      home__stab_fractions((uint32_t)y0 + 8u * (uint32_t)dy, dy), 1);
-    /* pixel k's offset k dx from its group's first pixel: k = 0-3 in off0, 4-7 in off1, per lane */
-    off0 = _mm256_setr_epi32(0, dx, 2 * dx, 3 * dx, 0, dx, 2 * dx, 3 * dx);
-    off1 = _mm256_add_epi32(off0, _mm256_set1_epi32(4 * dx));
-    for (; i + 16 <= n; i += 16, x += 16 * dx, y += 16 * dy) {
-        const int32_t x8 = x + 8 * dx, base0 = x >> HOME__WARP_FRAC_BITS, base1 = x8 >> HOME__WARP_FRAC_BITS;
-        /* sixteen pixels on one row pair (affine: the ends decide), each group's pairs in a
-         * window that stays inside the row */
-        if ((y >> HOME__WARP_FRAC_BITS) == ((y + 15 * dy) >> HOME__WARP_FRAC_BITS) && dx >= 0 &&
-            ((x8 - dx) >> HOME__WARP_FRAC_BITS) - base0 <= 14 && ((x8 + 7 * dx) >> HOME__WARP_FRAC_BITS) - base1 <= 14 &&
-            base1 + 16 <= w) {
-            const uint8_t *row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
-            /* index of pixel k's pair in its window: (frac + k dx) >> 16 */
-            const __m256i f = _mm256_setr_epi32(x & 0xffff, x & 0xffff, x & 0xffff, x & 0xffff,
-                                                x8 & 0xffff, x8 & 0xffff, x8 & 0xffff, x8 & 0xffff);
-            const __m256i k = _mm256_packs_epi32(_mm256_srli_epi32(_mm256_add_epi32(off0, f), HOME__WARP_FRAC_BITS),
-                                                 _mm256_srli_epi32(_mm256_add_epi32(off1, f), HOME__WARP_FRAC_BITS));
-            /* bytes (k, k + 1) of each 16-bit lane pick p0 and p1 */
-            const __m256i ctrl = _mm256_add_epi16(_mm256_or_si256(k, _mm256_slli_epi16(k, 8)), pair);
+    lo = (uint32_t)y0 & ~0xffffu;
+    yrel = (uint32_t)y0 + dy15 - lo;
+    row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
+    while (d < end) {
+        /* affine: a group's first pixel is on the tracked row when the previous group's last
+         * was, so its last decides; else it may be on the next row (then the whole group) */
+        while (d < fast_end && yrel < 0x10000u) {
+            const __m256i ctrl = _mm256_add_epi8(pairs, _mm256_cmpeq_epi16(_mm256_max_epu16(frac_x, edge), frac_x));
+            const uint32_t base0 = x >> HOME__WARP_FRAC_BITS, base1 = (x + dx8) >> HOME__WARP_FRAC_BITS;
             blend16(_mm256_shuffle_epi8(window(row, base0, base1), ctrl),
-                    _mm256_shuffle_epi8(window(row + stride, base0, base1), ctrl), frac_x, frac_y, dst + i);
-        } else {
-            group8(src, stride, x, y, dx, dy, _mm256_castsi256_si128(frac_x), _mm256_castsi256_si128(frac_y), dst + i);
-            group8(src, stride, x8, y + 8 * dy, dx, dy, _mm256_extracti128_si256(frac_x, 1),
-                   _mm256_extracti128_si256(frac_y, 1), dst + i + 8);
+                    _mm256_shuffle_epi8(window(row + stride, base0, base1), ctrl), frac_x, frac_y, d);
+            frac_x = _mm256_add_epi16(frac_x, step_x);
+            frac_y = _mm256_add_epi16(frac_y, step_y);
+            x += dx16;
+            yrel += dy16;
+            d += 16;
         }
-        frac_x = _mm256_add_epi16(frac_x, step_x);
-        frac_y = _mm256_add_epi16(frac_y, step_y);
+        if (d >= end) break;
+        {
+            const uint32_t y = lo + yrel - dy15, next = y + dy16;
+            if ((y & ~0xffffu) != lo) {   /* the row was crossed before this group: track the new one */
+                lo = y & ~0xffffu;
+                yrel = y + dy15 - lo;
+                row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+                continue;
+            }
+            if (d < fast_end && cross) {
+                /* the sixteen pixels cross one source row (|15 dy| < 2^16): the first is on the
+                 * tracked row, the rest there or on the next one in dy's direction, which its
+                 * fraction tells: dy > 0, at least the first's; dy < 0, at most */
+                const __m256i ctrl = _mm256_add_epi8(pairs, _mm256_cmpeq_epi16(_mm256_max_epu16(frac_x, edge), frac_x));
+                const __m256i f0 = _mm256_broadcastw_epi16(_mm256_castsi256_si128(frac_y));
+                const __m256i same = _mm256_cmpeq_epi16(dy > 0 ? _mm256_max_epu16(frac_y, f0) : _mm256_min_epu16(frac_y, f0), frac_y);
+                const uint32_t base0 = x >> HOME__WARP_FRAC_BITS, base1 = (x + dx8) >> HOME__WARP_FRAC_BITS;
+                const uint8_t *other = dy > 0 ? row + stride : row - stride;
+                const __m256i t0 = _mm256_shuffle_epi8(window(row, base0, base1), ctrl);
+                const __m256i b0 = _mm256_shuffle_epi8(window(row + stride, base0, base1), ctrl);
+                const __m256i t1 = dy > 0 ? b0 : _mm256_shuffle_epi8(window(other, base0, base1), ctrl);
+                const __m256i b1 = dy > 0 ? _mm256_shuffle_epi8(window(other + stride, base0, base1), ctrl) : t0;
+                blend16(_mm256_blendv_epi8(t1, t0, same), _mm256_blendv_epi8(b1, b0, same), frac_x, frac_y, d);
+            } else {
+                gather16(src, stride, x, y, dx, dy, frac_x, frac_y, d);
+            }
+            frac_x = _mm256_add_epi16(frac_x, step_x);
+            frac_y = _mm256_add_epi16(frac_y, step_y);
+            x += dx16;
+            d += 16;
+            if (d < end) {   /* next is a pixel of the row: inside; track its row */
+                lo = next & ~0xffffu;
+                yrel = next + dy15 - lo;
+                row = src + (ptrdiff_t)(next >> HOME__WARP_FRAC_BITS) * stride;
+            }
+        }
     }
-    if (i + 8 <= n) {
-        group8(src, stride, x, y, dx, dy, _mm256_castsi256_si128(frac_x), _mm256_castsi256_si128(frac_y), dst + i);
-        i += 8, x += 8 * dx, y += 8 * dy;
+    if (d < dst + n) {   /* the rest of an inside row: the reference's fast path, same bytes */
+        const uint32_t i = (uint32_t)(d - dst);
+        home__warp_row_c(src, stride, 1, w, h, (int32_t)x, (int32_t)((uint32_t)y0 + i * (uint32_t)dy), dx, dy, d, 1,
+                         n - (int)i);
     }
-    if (i < n)   /* the rest of an inside row: the reference's fast path, same bytes */
-        home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, n - i);
 }
 
 const home__stab_kernels home__stab_kernels_avx2 = {"avx2", warp_row_avx2};

@@ -1,6 +1,7 @@
 /* SSE2 warp row kernel: eight output pixels per step. A pixel's horizontal pairs are one 16-bit
- * load each (pinsrw), two loads instead of four, from row addresses shared while the eight
- * pixels read the same source rows (a near-horizontal warp: almost always); the blend is
+ * load each (pinsrw) at a column taken from a vector of the eight Q16 x (pextrw), from the row
+ * pair the kernel tracks while the row of the warp stays on it (a near-horizontal warp: almost
+ * always); a group that crosses a source row finds each pixel's rows. The blend is
  * port/stab_x86.h's. Rows that need clamping, or are not planar, use the reference. */
 #include "stab_kernels.h"
 #if defined(__SSE2__)
@@ -10,8 +11,11 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
                          int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
     const __m128i step_x = _mm_set1_epi16(home__stab_low16(0, dx, 8)), step_y = _mm_set1_epi16(home__stab_low16(0, dy, 8));
-    __m128i frac_x, frac_y, top, bot;
-    int32_t x = x0, y = y0;
+    const __m128i step8 = _mm_set1_epi32(home__stab_wrap32(0, dx, 8));
+    const uint32_t dy8 = 8u * (uint32_t)dy;
+    __m128i frac_x, frac_y, xa, xb, top, bot;
+    const uint8_t *row;
+    uint32_t ylast, lo;   /* last y of the group; first Q16 y of the tracked source row */
     int i = 0;
     if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
@@ -19,19 +23,34 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
     }
     frac_x = home__stab_fractions((uint32_t)x0, dx);
     frac_y = home__stab_fractions((uint32_t)y0, dy);
-    for (; i + 8 <= n; i += 8, x += 8 * dx, y += 8 * dy) {
-        /* affine: the eight pixels share their rows when the first and the last do; else (a
-         * row of the warp crossing a source row) each finds its own */
-        if ((y >> HOME__WARP_FRAC_BITS) == ((y + 7 * dy) >> HOME__WARP_FRAC_BITS))
-            home__stab_gather8(src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride, stride, (uint32_t)x, dx, &top, &bot);
-        else
-            home__stab_gather8_rows(src, stride, (uint32_t)x, y, dx, dy, &top, &bot);
+    home__stab_xs((uint32_t)x0, dx, &xa, &xb);
+    ylast = (uint32_t)y0 + 7u * (uint32_t)dy;
+    lo = (uint32_t)y0 & ~0xffffu;
+    row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
+    for (; i + 8 <= n; i += 8) {
+        /* affine: the group's first pixel is on the tracked row when the previous group's last
+         * was, so its last decides */
+        if (ylast - lo < 0x10000u) {
+            home__stab_gather8(row, stride, xa, xb, &top, &bot);
+        } else {   /* the group crosses a source row: each pixel's own rows; track the next group's */
+            const uint32_t next = ylast + (uint32_t)dy;
+            home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)(ylast - 7u * (uint32_t)dy), dx, dy,
+                                    &top, &bot);
+            if (i + 16 <= n) {   /* next is a pixel of the row: inside */
+                lo = next & ~0xffffu;
+                row = src + (ptrdiff_t)(next >> HOME__WARP_FRAC_BITS) * stride;
+            }
+        }
         home__stab_blend8(top, bot, frac_x, frac_y, dst + i);
         frac_x = _mm_add_epi16(frac_x, step_x);
         frac_y = _mm_add_epi16(frac_y, step_y);
+        xa = _mm_add_epi32(xa, step8);
+        xb = _mm_add_epi32(xb, step8);
+        ylast += dy8;
     }
     if (i < n)   /* the rest of an inside row: the reference's fast path, same bytes */
-        home__warp_row_c(src, stride, 1, w, h, x, y, dx, dy, dst + i, 1, n - i);
+        home__warp_row_c(src, stride, 1, w, h, (int32_t)((uint32_t)x0 + (uint32_t)i * (uint32_t)dx),
+                         (int32_t)((uint32_t)y0 + (uint32_t)i * (uint32_t)dy), dx, dy, dst + i, 1, n - i);
 }
 
 const home__stab_kernels home__stab_kernels_sse = {"sse", warp_row_sse};
