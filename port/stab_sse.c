@@ -12,11 +12,11 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
 {
     const __m128i step_x = _mm_set1_epi16(home__stab_low16(0, dx, 8)), step_y = _mm_set1_epi16(home__stab_low16(0, dy, 8));
     const __m128i step8 = _mm_set1_epi32(home__stab_wrap32(0, dx, 8));
-    const uint32_t dy8 = 8u * (uint32_t)dy;
+    const uint32_t dy7 = 7u * (uint32_t)dy, dy8 = 8u * (uint32_t)dy;
     __m128i frac_x, frac_y, xa, xb, top, bot;
     const uint8_t *row;
-    uint32_t ylast, lo;   /* last y of the group; first Q16 y of the tracked source row */
-    int i = 0;
+    uint8_t *d = dst, *const end = dst + (n & ~7);
+    uint32_t lo, yrel;   /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
     if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
@@ -24,33 +24,36 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
     frac_x = home__stab_fractions((uint32_t)x0, dx);
     frac_y = home__stab_fractions((uint32_t)y0, dy);
     home__stab_xs((uint32_t)x0, dx, &xa, &xb);
-    ylast = (uint32_t)y0 + 7u * (uint32_t)dy;
     lo = (uint32_t)y0 & ~0xffffu;
+    yrel = (uint32_t)y0 + dy7 - lo;
     row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
-    for (; i + 8 <= n; i += 8) {
-        /* affine: the group's first pixel is on the tracked row when the previous group's last
+    while (d < end) {
+        /* affine: a group's first pixel is on the tracked row when the previous group's last
          * was, so its last decides */
-        if (ylast - lo < 0x10000u) {
+        if (yrel < 0x10000u) {
             home__stab_gather8(row, stride, xa, xb, &top, &bot);
-        } else {   /* the group crosses a source row: each pixel's own rows; track the next group's */
-            const uint32_t next = ylast + (uint32_t)dy;
-            home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)(ylast - 7u * (uint32_t)dy), dx, dy,
-                                    &top, &bot);
-            if (i + 16 <= n) {   /* next is a pixel of the row: inside */
+        } else {   /* the group crosses a source row, here or before it: each pixel's own rows */
+            const uint32_t y = lo + yrel - dy7, next = y + dy8;
+            home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)y, dx, dy, &top, &bot);
+            if (d + 8 < end) {   /* next is a pixel of the row: inside; track its row */
                 lo = next & ~0xffffu;
+                yrel = y + dy7 - lo;   /* next + dy7 - lo after the step below */
                 row = src + (ptrdiff_t)(next >> HOME__WARP_FRAC_BITS) * stride;
             }
         }
-        home__stab_blend8(top, bot, frac_x, frac_y, dst + i);
+        home__stab_blend8(top, bot, frac_x, frac_y, d);
         frac_x = _mm_add_epi16(frac_x, step_x);
         frac_y = _mm_add_epi16(frac_y, step_y);
         xa = _mm_add_epi32(xa, step8);
         xb = _mm_add_epi32(xb, step8);
-        ylast += dy8;
+        yrel += dy8;
+        d += 8;
     }
-    if (i < n)   /* the rest of an inside row: the reference's fast path, same bytes */
-        home__warp_row_c(src, stride, 1, w, h, (int32_t)((uint32_t)x0 + (uint32_t)i * (uint32_t)dx),
-                         (int32_t)((uint32_t)y0 + (uint32_t)i * (uint32_t)dy), dx, dy, dst + i, 1, n - i);
+    if (d < dst + n) {   /* the rest of an inside row: the reference's fast path, same bytes */
+        const uint32_t i = (uint32_t)(d - dst);
+        home__warp_row_c(src, stride, 1, w, h, (int32_t)((uint32_t)x0 + i * (uint32_t)dx),
+                         (int32_t)((uint32_t)y0 + i * (uint32_t)dy), dx, dy, d, 1, n - (int)i);
+    }
 }
 
 const home__stab_kernels home__stab_kernels_sse = {"sse", warp_row_sse};
