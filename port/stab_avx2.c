@@ -58,59 +58,69 @@ __attribute__((noinline)) static void gather16(const uint8_t *src, ptrdiff_t str
 static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                           int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
 {
-    const __m256i step_x = _mm256_set1_epi16(home__stab_low16(0, dx, 16)), step_y = _mm256_set1_epi16(home__stab_low16(0, dy, 16));
     const uint32_t dx8 = 8u * (uint32_t)dx, dx16 = 16u * (uint32_t)dx, dy15 = 15u * (uint32_t)dy, dy16 = 16u * (uint32_t)dy;
     /* the shuffle path: the pairs of a group of eight within 16 bytes (dx in [0, 2): pixel 7's
      * pair at offset <= 13 + 1) and the windows inside the row (x8 >> 16 <= w - 16, x8 = x + 8 dx
      * the second group's first pixel: x8 < xlim); x grows, so a prefix of the groups */
     const uint32_t xlim = dx >= 0 && dx < (2 << HOME__WARP_FRAC_BITS) && w >= 16 ? (uint32_t)(w - 15) << HOME__WARP_FRAC_BITS : 0;
-    __m256i frac_x, frac_y, edge, pairs;
+    const int cross = dy > -4096 && dy < 4096;   /* 15 |dy| < 2^16: a group spans at most two source rows */
+    const __m256i lane = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    __m256i frac_x, frac_y, edge, pairs, step_x, step_y;
     const uint8_t *row;
     uint8_t *d = dst, *const end = dst + (n & ~15), *fast_end;
     uint32_t x = (uint32_t)x0, lo, yrel;   /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
-    const int cross = dy > -4096 && dy < 4096;   /* 15 |dy| < 2^16: a group spans at most two source rows */
-    int k;
     if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
     {
+        /* k dq & 0xffff = k (dq & 0xffff) & 0xffff: the fractions of pixels k = 0..15 are the
+         * first's plus lanes k of these (wrapping like the Q16 sums) */
+        const __m256i ex = _mm256_mullo_epi16(_mm256_set1_epi16(home__stab_low16(0, dx, 1)), lane);
+        const __m256i ey = _mm256_mullo_epi16(_mm256_set1_epi16(home__stab_low16(0, dy, 1)), lane);
         /* pixel k of a group (first pixel's fraction f) has its pair at window offset D_k + carry,
          * D_k = (k dx) >> 16, carry = f + (k dx & 0xffff) >= 2^16: its own fraction below
          * e_k = k dx & 0xffff. The control bytes (D_k + carry, D_k + 1 + carry) are
-         * pairs + (D_k + 1) 0x0101 less the bytes of the mask "fraction >= e_k" (all ones). */
-        short dk[8];
-        const uint32_t x8 = x + dx8, groups = (uint32_t)n / 16;
+         * pairs = (D_k + 1) 0x0101 + 0x0100 less the bytes of the mask "fraction >= e_k" (all
+         * ones). Only used with dx in [0, 2): k dx < 2^20, D_k < 16. */
+        const __m256i kdx = _mm256_mullo_epi32(_mm256_set1_epi32(dx & 0x1ffff), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        const __m256i dk = _mm256_packus_epi32(_mm256_srli_epi32(kdx, HOME__WARP_FRAC_BITS), _mm256_setzero_si256());
+        const uint32_t groups = (uint32_t)n / 16;
         uint32_t fast = 0;
-        for (k = 0; k < 8; k++) dk[k] = (short)(((uint32_t)k * (uint32_t)dx >> HOME__WARP_FRAC_BITS & 0xff) * 257 + 513);
-        pairs = _mm256_broadcastsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)dk));
-        edge = _mm256_broadcastsi128_si256(home__stab_fractions(0, dx));
-        if (x8 < xlim) fast = dx16 ? (xlim - 1 - x8) / dx16 + 1 : groups;
+        pairs = _mm256_add_epi16(_mm256_mullo_epi16(_mm256_permute4x64_epi64(dk, 0x88), _mm256_set1_epi16(257)),
+                                 _mm256_set1_epi16(513));   /* lanes 0-7 | 0-7 */
+        edge = _mm256_permute2x128_si256(ex, ex, 0x00);
+        step_x = _mm256_set1_epi16(home__stab_low16(0, dx, 16));
+        step_y = _mm256_set1_epi16(home__stab_low16(0, dy, 16));
+        frac_x = _mm256_add_epi16(_mm256_set1_epi16(home__stab_low16((uint32_t)x0, 0, 0)), ex);
+        frac_y = _mm256_add_epi16(_mm256_set1_epi16(home__stab_low16((uint32_t)y0, 0, 0)), ey);
+        if (x + dx8 < xlim) fast = dx16 ? (xlim - 1 - x - dx8) / dx16 + 1 : groups;
         fast_end = dst + 16 * (ptrdiff_t)(fast < groups ? fast : groups);
     }
-    /* pixels 0-7 | 8-15 (the start wraps like the fractions: rows shorter than 16 never use it) */
-    frac_x = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions((uint32_t)x0, dx)),
-                                     home__stab_fractions((uint32_t)x0 + dx8, dx), 1);
-    frac_y = _mm256_inserti128_si256(_mm256_castsi128_si256(home__stab_fractions((uint32_t)y0, dy)),
-                                     home__stab_fractions((uint32_t)y0 + 8u * (uint32_t)dy, dy), 1);
     lo = (uint32_t)y0 & ~0xffffu;
     yrel = (uint32_t)y0 + dy15 - lo;
     row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
     while (d < end) {
-        /* affine: a group's first pixel is on the tracked row when the previous group's last
-         * was, so its last decides; else it may be on the next row (then the whole group) */
-        while (d < fast_end && yrel < 0x10000u) {
-            const __m256i ctrl = _mm256_add_epi8(pairs, _mm256_cmpeq_epi16(_mm256_max_epu16(frac_x, edge), frac_x));
-            const uint32_t base0 = x >> HOME__WARP_FRAC_BITS, base1 = (x + dx8) >> HOME__WARP_FRAC_BITS;
-            blend16(_mm256_shuffle_epi8(window(row, base0, base1), ctrl),
-                    _mm256_shuffle_epi8(window(row + stride, base0, base1), ctrl), frac_x, frac_y, d);
-            frac_x = _mm256_add_epi16(frac_x, step_x);
-            frac_y = _mm256_add_epi16(frac_y, step_y);
-            x += dx16;
-            yrel += dy16;
-            d += 16;
+        if (d < fast_end && yrel < 0x10000u) {
+            /* affine: a group's first pixel is on the tracked row when the previous group's last
+             * was, so its last decides: the groups up to stop stay on it (yrel + (g - 1) dy16 in
+             * [0, 2^16) for g of them) */
+            const uint8_t *const row1 = row + stride;
+            const uint32_t g = dy > 0 ? (0xffffu - yrel) / dy16 + 1 : dy < 0 ? yrel / (0u - dy16) + 1 : 0xffffffu;
+            uint8_t *const stop = (uint32_t)(fast_end - d) / 16 > g ? d + 16 * (ptrdiff_t)g : fast_end;
+            yrel += (uint32_t)(stop - d) / 16 * dy16;
+            do {
+                const __m256i ctrl = _mm256_add_epi8(pairs, _mm256_cmpeq_epi16(_mm256_max_epu16(frac_x, edge), frac_x));
+                const uint32_t base0 = x >> HOME__WARP_FRAC_BITS, base1 = (x + dx8) >> HOME__WARP_FRAC_BITS;
+                blend16(_mm256_shuffle_epi8(window(row, base0, base1), ctrl),
+                        _mm256_shuffle_epi8(window(row1, base0, base1), ctrl), frac_x, frac_y, d);
+                frac_x = _mm256_add_epi16(frac_x, step_x);
+                frac_y = _mm256_add_epi16(frac_y, step_y);
+                x += dx16;
+                d += 16;
+            } while (d < stop);
+            continue;
         }
-        if (d >= end) break;
         {
             const uint32_t y = lo + yrel - dy15, next = y + dy16;
             if ((y & ~0xffffu) != lo) {   /* the row was crossed before this group: track the new one */
