@@ -21,8 +21,15 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
-    frac_x = home__stab_fractions((uint32_t)x0, dx);
-    frac_y = home__stab_fractions((uint32_t)y0, dy);
+    {
+        /* k dq & 0xffff = k (dq & 0xffff) & 0xffff: the fractions of pixels k = 0..7 are the
+         * first's plus lanes k of these (wrapping like the Q16 sums) */
+        const __m128i lane = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+        frac_x = _mm_add_epi16(_mm_set1_epi16(home__stab_low16((uint32_t)x0, 0, 0)),
+                               _mm_mullo_epi16(_mm_set1_epi16(home__stab_low16(0, dx, 1)), lane));
+        frac_y = _mm_add_epi16(_mm_set1_epi16(home__stab_low16((uint32_t)y0, 0, 0)),
+                               _mm_mullo_epi16(_mm_set1_epi16(home__stab_low16(0, dy, 1)), lane));
+    }
     home__stab_xs((uint32_t)x0, dx, &xa, &xb);
     lo = (uint32_t)y0 & ~0xffffu;
     yrel = (uint32_t)y0 + dy7 - lo;
