@@ -18,15 +18,6 @@ static uint16_t load_pair(const uint8_t *p)
     return v;
 }
 
-/* the fractions (q + k dq) & 0xffff, k = 0..7 */
-static uint16x8_t fractions(uint32_t q, int32_t dq)
-{
-    uint16_t f[8];
-    int k;
-    for (k = 0; k < 8; k++) f[k] = (uint16_t)(q + (uint32_t)k * (uint32_t)dq);   /* wraps */
-    return vld1q_u16(f);
-}
-
 /* bytes w[idx[k]], idx[k] < 16 */
 static inline uint8x8_t lookup(uint8x16_t w, uint8x8_t idx)
 {
@@ -84,6 +75,8 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w,
      * prefix of the groups */
     const uint32_t xlim = dx >= 0 && dx < (2 << HOME__WARP_FRAC_BITS) && w >= 16 ? (uint32_t)(w - 15) << HOME__WARP_FRAC_BITS : 0;
     const int cross = dy > -8192 && dy < 8192;   /* 7 |dy| < 2^16: a group spans at most two source rows */
+    static const uint16_t lanes[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    const uint16x8_t lane = vld1q_u16(lanes);
     uint16x8_t frac_x, frac_y, edge;
     uint8x8_t k0, k1;
     const uint8_t *row;
@@ -105,29 +98,38 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w,
         for (k = 0; k < 8; k++) dk[k] = (uint8_t)(((uint32_t)k * (uint32_t)dx >> HOME__WARP_FRAC_BITS & 0x3f) + 1);
         k0 = vld1_u8(dk);
         k1 = vadd_u8(k0, vdup_n_u8(1));
-        edge = fractions(0, dx);
+        edge = vmulq_n_u16(lane, (uint16_t)dx);
         if (x < xlim) fast = dx8 ? (xlim - 1 - x) / dx8 + 1 : groups;
         fast_end = dst + 8 * (ptrdiff_t)(fast < groups ? fast : groups);
     }
-    frac_x = fractions((uint32_t)x0, dx);
-    frac_y = fractions((uint32_t)y0, dy);
+    /* k dq & 0xffff = k (dq & 0xffff) & 0xffff: the fractions of pixels k = 0..7 are the first's
+     * plus lanes k of these (wrapping like the Q16 sums) */
+    frac_x = vaddq_u16(vdupq_n_u16((uint16_t)x0), edge);
+    frac_y = vaddq_u16(vdupq_n_u16((uint16_t)y0), vmulq_n_u16(lane, (uint16_t)dy));
     lo = (uint32_t)y0 & ~0xffffu;
     yrel = (uint32_t)y0 + dy7 - lo;
     row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
     while (d < end) {
-        /* affine: a group's first pixel is on the tracked row when the previous group's last
-         * was, so its last decides; else it may be on the next row (then the whole group) */
-        while (d < fast_end && yrel < 0x10000u) {
-            const uint8x8_t m = vmovn_u16(vcgeq_u16(frac_x, edge)), i0 = vadd_u8(k0, m), i1 = vadd_u8(k1, m);
-            const uint8x16_t wt = vld1q_u8(row + (x >> HOME__WARP_FRAC_BITS)), wb = vld1q_u8(row + stride + (x >> HOME__WARP_FRAC_BITS));
-            blend8(lookup(wt, i0), lookup(wt, i1), lookup(wb, i0), lookup(wb, i1), frac_x, frac_y, d);
-            frac_x = vaddq_u16(frac_x, step_x);
-            frac_y = vaddq_u16(frac_y, step_y);
-            x += dx8;
-            yrel += dy8;
-            d += 8;
+        if (d < fast_end && yrel < 0x10000u) {
+            /* affine: a group's first pixel is on the tracked row when the previous group's last
+             * was, so its last decides: the groups up to stop stay on it (yrel + (g - 1) dy8 in
+             * [0, 2^16) for g of them) */
+            const uint8_t *const row1 = row + stride;
+            const uint32_t g = dy > 0 ? (0xffffu - yrel) / dy8 + 1 : dy < 0 ? yrel / (0u - dy8) + 1 : 0xffffffu;
+            uint8_t *const stop = (uint32_t)(fast_end - d) / 8 > g ? d + 8 * (ptrdiff_t)g : fast_end;
+            yrel += (uint32_t)(stop - d) / 8 * dy8;
+            do {
+                const uint8x8_t m = vmovn_u16(vcgeq_u16(frac_x, edge)), i0 = vadd_u8(k0, m), i1 = vadd_u8(k1, m);
+                const uint32_t base = x >> HOME__WARP_FRAC_BITS;
+                const uint8x16_t wt = vld1q_u8(row + base), wb = vld1q_u8(row1 + base);
+                blend8(lookup(wt, i0), lookup(wt, i1), lookup(wb, i0), lookup(wb, i1), frac_x, frac_y, d);
+                frac_x = vaddq_u16(frac_x, step_x);
+                frac_y = vaddq_u16(frac_y, step_y);
+                x += dx8;
+                d += 8;
+            } while (d < stop);
+            continue;
         }
-        if (d >= end) break;
         {
             const uint32_t y = lo + yrel - dy7, next = y + dy8;
             if ((y & ~0xffffu) != lo) {   /* the row was crossed before this group: track the new one */
