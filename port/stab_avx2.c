@@ -13,11 +13,11 @@
 #include <immintrin.h>
 
 /* Sixteen pixels (lanes: pixels 0-7 | 8-15) whose pairs sit as p0 | p1 << 8 in the 16-bit lanes
- * of top and bottom, blended with the reference's 7-bit weights into dst[0..15], its bytes
+ * of top and bottom, blended with the reference's 7-bit weights (16-bit results), its bytes
  * exactly: with fx = HOME__WARP_WEIGHT of the x fraction, the bytes (128 - fx, fx) times the
  * pairs less 128 give top - 16384 (|products| <= 2^14: no saturation), and
  * (top - 2^14) (128 - fy) + (bot - 2^14) fy = R - 2^21, so the result is (that + 2^21 + 2^13) >> 14. */
-static inline void blend16(__m256i top, __m256i bot, __m256i frac_x, __m256i frac_y, uint8_t *dst)
+static inline __m256i blend16_words(__m256i top, __m256i bot, __m256i frac_x, __m256i frac_y)
 {
     const __m256i zero = _mm256_setzero_si256(), c128 = _mm256_set1_epi16(128), flip = _mm256_set1_epi8(-128);
     /* HOME__WARP_WEIGHT of 16-bit fractions: (f + 256) >> 9 = ((f >> 8) + 1) >> 1, pavgw with 0 */
@@ -31,8 +31,14 @@ static inline void blend16(__m256i top, __m256i bot, __m256i frac_x, __m256i fra
     __m256i r1 = _mm256_madd_epi16(_mm256_unpackhi_epi16(t, b), _mm256_unpackhi_epi16(gy, fy));
     r0 = _mm256_srli_epi32(_mm256_add_epi32(r0, round), 14);
     r1 = _mm256_srli_epi32(_mm256_add_epi32(r1, round), 14);
-    r0 = _mm256_packus_epi16(_mm256_packs_epi32(r0, r1), zero);   /* lanes: bytes 0-7 | 8-15 */
-    _mm_storeu_si128((__m128i *)(void *)dst, _mm256_castsi256_si128(_mm256_permute4x64_epi64(r0, 0x08)));
+    return _mm256_packs_epi32(r0, r1);   /* 16-bit lanes: pixels 0-7 | 8-15 */
+}
+
+/* blend16_words's pixels into dst[0..15] */
+static inline void blend16(__m256i top, __m256i bot, __m256i frac_x, __m256i frac_y, uint8_t *dst)
+{
+    const __m256i r = _mm256_packus_epi16(blend16_words(top, bot, frac_x, frac_y), _mm256_setzero_si256());
+    _mm_storeu_si128((__m128i *)(void *)dst, _mm256_castsi256_si128(_mm256_permute4x64_epi64(r, 0x08)));   /* lanes: bytes 0-7 | 8-15 */
 }
 
 /* one 16-byte window per row and lane: lane j's window starts at column base_j */
@@ -109,16 +115,30 @@ static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w,
             const uint32_t g = dy > 0 ? (0xffffu - yrel) / dy16 + 1 : dy < 0 ? yrel / (0u - dy16) + 1 : 0xffffffu;
             uint8_t *const stop = (uint32_t)(fast_end - d) / 16 > g ? d + 16 * (ptrdiff_t)g : fast_end;
             yrel += (uint32_t)(stop - d) / 16 * dy16;
-            do {
-                const __m256i ctrl = _mm256_add_epi8(pairs, _mm256_cmpeq_epi16(_mm256_max_epu16(frac_x, edge), frac_x));
-                const uint32_t base0 = x >> HOME__WARP_FRAC_BITS, base1 = (x + dx8) >> HOME__WARP_FRAC_BITS;
-                blend16(_mm256_shuffle_epi8(window(row, base0, base1), ctrl),
-                        _mm256_shuffle_epi8(window(row1, base0, base1), ctrl), frac_x, frac_y, d);
-                frac_x = _mm256_add_epi16(frac_x, step_x);
-                frac_y = _mm256_add_epi16(frac_y, step_y);
+#define HOME__STAB_GROUP(words, x)                                                                          \
+    {                                                                                                       \
+        const __m256i ctrl = _mm256_add_epi8(pairs, _mm256_cmpeq_epi16(_mm256_max_epu16(frac_x, edge), frac_x)); \
+        const uint32_t base0 = (x) >> HOME__WARP_FRAC_BITS, base1 = ((x) + dx8) >> HOME__WARP_FRAC_BITS;    \
+        words = blend16_words(_mm256_shuffle_epi8(window(row, base0, base1), ctrl),                         \
+                              _mm256_shuffle_epi8(window(row1, base0, base1), ctrl), frac_x, frac_y);      \
+        frac_x = _mm256_add_epi16(frac_x, step_x);                                                          \
+        frac_y = _mm256_add_epi16(frac_y, step_y);                                                          \
+    }
+            for (; d + 32 <= stop; d += 32, x += 2 * dx16) {   /* two groups: one pack and store */
+                __m256i r0, r1;
+                HOME__STAB_GROUP(r0, x)
+                HOME__STAB_GROUP(r1, x + dx16)
+                _mm256_storeu_si256((__m256i *)(void *)d, _mm256_permute4x64_epi64(_mm256_packus_epi16(r0, r1), 0xd8));
+            }
+            if (d < stop) {
+                __m256i r0;
+                HOME__STAB_GROUP(r0, x)
+                r0 = _mm256_packus_epi16(r0, _mm256_setzero_si256());
+                _mm_storeu_si128((__m128i *)(void *)d, _mm256_castsi256_si128(_mm256_permute4x64_epi64(r0, 0x08)));
                 x += dx16;
                 d += 16;
-            } while (d < stop);
+            }
+#undef HOME__STAB_GROUP
             continue;
         }
         {
