@@ -111,21 +111,28 @@ static double refine_from(home_context *ctx, const double *h, double p_start, ui
     return synth_corner_error(res->H, h, IMG_W, IMG_H);
 }
 
-void test_textured_subpixel(void)
+/* Textured pairs 10, 25, 40 px apart (the first `pairs`), refined from 2 px off: each accepted
+ * and within max_err px. */
+static void textured_refines(home_context *ctx, int pairs, double max_err)
 {
-    home_context *ctx = context(NULL);
     int k;
-    if (!ctx) { CHECK(0); return; }
-    for (k = 0; k < 3; k++) {
+    for (k = 0; k < pairs; k++) {
         double h[9], err;
         home_result res;
         textured_pair(100 + k, 10 + 15 * k, 1.0, h);
         err = refine_from(ctx, h, 2.0, 7 + k, &res);
-        printf("     textured p=%d: start 2 px off -> %.3f px, status %d, %d iterations\n",
-               10 + 15 * k, err, res.refine_status, res.refine_iterations);
+        printf("     %d points, textured p=%d: start 2 px off -> %.3f px, status %d, %d iterations\n",
+               ctx->cfg.refine_points, 10 + 15 * k, err, res.refine_status, res.refine_iterations);
         CHECK(res.refined);
-        CHECK_LT(err, 0.1);
+        CHECK_LT(err, max_err);
     }
+}
+
+void test_textured_subpixel(void)
+{
+    home_context *ctx = context(NULL);
+    if (!ctx) { CHECK(0); return; }
+    textured_refines(ctx, 3, 0.1);
 }
 
 /* A smaller point budget: a quarter of the points still refine to sub-pixel, in a smaller
@@ -135,25 +142,15 @@ void test_point_budget(void)
     home_config cfg;
     home_context *ctx;
     size_t full;
-    int k;
     home_default_config(&cfg, IMG_W, IMG_H);
     full = home_arena_size(&cfg);
     cfg.refine_points = HOME_REFINE_MAX_POINTS / 4;
     CHECK(home_arena_size(&cfg) < full);
     ctx = context(&cfg);
     if (!ctx) { CHECK(0); return; }
-    for (k = 0; k < 2; k++) {
-        double h[9], err;
-        home_result res;
-        textured_pair(100 + k, 10 + 15 * k, 1.0, h);
-        err = refine_from(ctx, h, 2.0, 7 + k, &res);
-        printf("     %d points, textured p=%d: start 2 px off -> %.3f px, status %d\n",
-               cfg.refine_points, 10 + 15 * k, err, res.refine_status);
-        CHECK(res.refined);
-        CHECK_LT(err, 0.15);
-        CHECK(ctx->refine.tpl[0][0].n + ctx->refine.tpl[1][0].n <= 2 * cfg.refine_points);
-        CHECK(ctx->refine.tpl[0][0].n > cfg.refine_points / 2);
-    }
+    textured_refines(ctx, 2, 0.15);
+    CHECK(ctx->refine.tpl[0][0].n + ctx->refine.tpl[1][0].n <= 2 * cfg.refine_points);
+    CHECK(ctx->refine.tpl[0][0].n > cfg.refine_points / 2);
 }
 
 void test_lines_subpixel(void)
