@@ -41,11 +41,11 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
     }
 }
 
-/* Copy the image (box-downscaled when hough_downscale is 2 or 4) into the zero-padded buffers
- * (HOME__RADON_BLOCK columns each side) used by the shear-and-add kernel: img_n as is, img_t
- * transposed from it. */
 static void prefix_edges(home_context *ctx);
 
+/* Copy the image (box-downscaled when hough_downscale is 2 or 4) into the zero-padded buffers
+ * (HOME__RADON_BLOCK columns each side) used by the shear-and-add kernel: img_n as is, img_t
+ * transposed from it; then the border prefix sums. */
 static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
 {
     const int width = ctx->hough_w, height = ctx->hough_h, pad = HOME__RADON_BLOCK;

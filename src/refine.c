@@ -11,7 +11,8 @@
  *
  * Template points: per level, the pixel of largest |gx| + |gy| in each block (4x4, 2x2 at the
  * third level) whose score clears a camera-noise floor, strongest first (evenly spread) up to
- * HOME_REFINE_MAX_POINTS >> level. Flat regions contribute nothing to LK but time.
+ * refine_points >> level (at most HOME_REFINE_MAX_POINTS). Flat regions contribute nothing to
+ * LK but time.
  *
  * The estimate ends at full resolution, or at the finest level with at least 512 template
  * points (faint texture leaves few points above the noise floor at full resolution).
@@ -488,10 +489,10 @@ static int iterate(solver *s, int level, double *step_px)
     aff[0] = (float)(sc / s->f);
     aff[1] = (float)((o - s->cx) / s->f);
     aff[2] = (float)((o - s->cy) / s->f);
-    /* J^T W J only at a level's first iteration, then reused: in the inverse-compositional
-     * form it changes only through the weights, which settle after that first step, and an
-     * approximate matrix changes the path to the solution, not the solution (J^T W r = 0).
-     * J^T W J is 36 of the 44 sums per point. */
+    /* J^T W J at a level's first iteration, then reused while the steps keep halving (a fresh
+     * one otherwise, see refine()): in the inverse-compositional form it changes only through
+     * the weights, and an approximate matrix changes the path to the solution, not the solution
+     * (J^T W r = 0). J^T W J is 36 of the 44 sums per point. */
     st->rk->accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff,
                        s->hessian_level != level, acc);
     s->hessian_level = level;
