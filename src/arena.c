@@ -255,7 +255,7 @@ static void plan(const home_config *cfg, layout *l)
         l->geom_longest = (int)longest;
         l->geom_blocks = (int)(intercepts / HOME__RADON_BLOCK + 1);
         l->geom_intercepts = w + h + 8; /* a row's intercepts, without the kernel's block slack */
-        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, intercepts, r_bins);
+        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, l->geom_intercepts, r_bins);
         {
             int rows;
             home__hough_raw_rows(cfg, (int)radius, &l->geom_first, &rows);
