@@ -74,8 +74,8 @@ typedef struct home_stab_config {
     int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
                                  2x2- or 4x4-box downscaled copy (2, 4), see home_config; 0 =
                                  automatic (home_video_config's: a copy about 160 px wide) */
-    int theta_bins;           /* HOME's theta bins; 0 = automatic (88, about half
-                                 home_video_config's: the refinement gives the precision);
+    int theta_bins;           /* HOME's theta bins; 0 = automatic (88, fewer than
+                                 home_video_config's 120: the refinement gives the precision);
                                  fewer suit tiny frames */
     int simd;                 /* enum home_simd for HOME and the warp (default: HOME_SIMD env or
                                  the best compiled in) */
