@@ -75,7 +75,7 @@ static void smooth_cols_avx2(const float *const *rows, float *out, int n, const 
     }
 }
 
-/* The SSE2 kernel's test on eight bins per step; the rest of the row through it. */
+/* The SSE2 kernel's test on eight bins per step. */
 static int extremum_candidates_avx2(const float *up, const float *mid, const float *down, int n,
                                     int *idx)
 {
@@ -96,12 +96,8 @@ static int extremum_candidates_avx2(const float *up, const float *mid, const flo
         for (lane = 0; mask; lane++, mask >>= 1)
             if (mask & 1) idx[count++] = i + lane;
     }
-    /* the remaining bins: the SSE2 kernel from i - 1 (it starts at index 1 of what it gets) */
-    if (i < n - 1) {
-        int k, tail = home__extremum_candidates_sse(up + i - 1, mid + i - 1, down + i - 1, n - i + 1, idx + count);
-        for (k = 0; k < tail; k++) idx[count + k] += i - 1;
-        count += tail;
-    }
+    for (; i < n - 1; i++)
+        if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
     return count;
 }
 
