@@ -180,7 +180,7 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
     const int b = block_side(level);
     const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
     const int log2b = b == 4 ? 2 : b == 2 ? 1 : 0;
-    int hist[256], hist4[4][256], bx, by, x, y, dy, bin, quota, n = 0, cut, above, i, j;
+    int hist[256], hist4[4][256], bx, by, x, y, dy, bin, quota, n = 0, cut, above, i, spread;
     const int floor_bin = score_floor(level) / 2;
     memset(hist4, 0, sizeof hist4);
     /* pass 1: best key (score << 4 | offset) of every block, histogram of score bins */
@@ -213,8 +213,10 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
     }
     quota = out->capacity - above;
     /* pass 2: every block above the cut bin, and of the cut bin an evenly spread quota (the
-     * j-th of its members when j * quota / count steps), so no image region is favoured */
-    for (by = 0, i = 0, j = 0; by < bh; by++) {
+     * j-th of its members when floor(j * quota / count) steps), so no image region is favoured.
+     * quota <= count, so that floor steps by 0 or 1: spread carries (j * quota) mod count, and a
+     * member is kept when adding quota wraps it (no division per member). */
+    for (by = 0, i = 0, spread = 0; by < bh; by++) {
         for (bx = 0; bx < bw; bx++, i++) {
             /* branch-free compaction: always write, advance only when kept (the arrays have
              * a lane of slack); only the cut bin's members take a branch */
@@ -236,8 +238,9 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
             bin = key >> 5;
             keep = bin > cut;
             if (bin == cut) {
-                keep = (long)(j + 1) * quota / hist[cut] != (long)j * quota / hist[cut];
-                j++;
+                spread += quota;
+                keep = spread >= hist[cut];
+                spread -= keep ? hist[cut] : 0;
             }
             out->x[n] = (int16_t)(bx * b + (key & (b - 1)));
             out->y[n] = (int16_t)(by * b + ((key & 15) >> log2b));
