@@ -139,6 +139,8 @@ typedef struct home_keypoint {
     uint8_t has_alt;          /* near the theta wrap: alt_desc is valid */
     uint8_t desc[HOME_DESC_LEN];
     uint8_t alt_desc[HOME_DESC_LEN]; /* descriptor of (theta +- pi, -r, -sign) */
+    double cos_theta, sin_theta;     /* cos and sin of (double)theta, the line's normal: set by
+                                        home_extract(), read by matching (edit theta, set them) */
 } home_keypoint;
 
 /* A frame's features. Caller-owned; fill with home_extract(). Positive keypoints come first

@@ -13,6 +13,15 @@ void home__match_set(home__match *m, float theta_a, float r_a, float theta_b, fl
     m->cos_b = cos((double)theta_b); m->sin_b = sin((double)theta_b);
 }
 
+/* A match of two keypoints as they are: their normals come with them (no cos/sin per match;
+ * in video, a frame's keypoints are matched twice) */
+static void match_keypoints(home__match *m, const home_keypoint *a, const home_keypoint *b)
+{
+    m->theta_a = a->theta; m->r_a = a->r; m->theta_b = b->theta; m->r_b = b->r;
+    m->cos_a = a->cos_theta; m->sin_a = a->sin_theta;
+    m->cos_b = b->cos_theta; m->sin_b = b->sin_theta;
+}
+
 /* Best candidate in b's keypoints [lo, hi) passing the ratio test, or -1. */
 static int best_match(const home__kernels *kernels, const uint8_t *desc, const home_features *b,
                       int lo, int hi, float ratio)
@@ -102,7 +111,7 @@ int home__match_features(home_context *ctx, const home_features *a, const home_f
         int j = window > 0.0f ? best_match_window(ctx, q->desc, q->theta, same_lo, same_hi, window, ratio)
                               : best_match(ctx->kernels, q->desc, b, same_lo, same_hi, ratio);
         if (j >= 0 && n < ctx->max_matches)
-            home__match_set(&ctx->matches[n++], q->theta, q->r, b->kp[j].theta, b->kp[j].r);
+            match_keypoints(&ctx->matches[n++], q, &b->kp[j]);
         if (!q->has_alt) continue;
         j = window > 0.0f ? best_match_window(ctx, q->alt_desc, alt_theta, opp_lo, opp_hi, window, ratio)
                           : best_match(ctx->kernels, q->alt_desc, b, opp_lo, opp_hi, ratio);

@@ -93,8 +93,10 @@ static void fill_keypoints(const home_context *ctx, home__heap *heap, int sign, 
         if (kp->theta >= (float)HOME__PI) kp->theta = nextafterf((float)HOME__PI, 0.0f); /* [0, pi) */
         /* r in full-image px: scale up from the (possibly downscaled) Hough image and move to
          * the full image's centre */
+        kp->cos_theta = cos((double)kp->theta);
+        kp->sin_theta = sin((double)kp->theta);
         kp->r = (float)(ctx->hough_scale * (c->r_bin - centre_bin) * ctx->cfg.r_step +
-                        cos((double)kp->theta) * ctx->hough_dx + sin((double)kp->theta) * ctx->hough_dy);
+                        kp->cos_theta * ctx->hough_dx + kp->sin_theta * ctx->hough_dy);
         kp->saliency = c->saliency;
         kp->sign = (int8_t)sign;
         kp->has_alt = (uint8_t)(c->theta_bin < (float)band || c->theta_bin > (float)(n_theta - band));

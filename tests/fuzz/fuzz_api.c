@@ -215,6 +215,10 @@ static int corrupt_features(fz_reader *r, const home_config *cfg, home_features 
             f->kp[i].r = fz_float_bits(r);
             f->kp[i].sign = (int8_t)fz_u8(r);
             f->kp[i].has_alt = (uint8_t)fz_u8(r);
+            if (fz_remaining(r) >= 8) {
+                f->kp[i].cos_theta = fz_float_bits(r);
+                f->kp[i].sin_theta = fz_float_bits(r);
+            }
         }
         return HOME_OK;
     }
