@@ -2,6 +2,7 @@
  * similarities, constant-velocity Kalman filter plus fixed-lag RTS smoothing over the lookahead,
  * crop-window constraint, hold-on-failure. See include/home_stab.h for the contract. */
 #include "home_stab.h"
+#include "kernels.h"
 #include "stab_kernels.h"
 #include <math.h>
 #include <string.h>
@@ -30,6 +31,9 @@ struct home_stab {
     home_features *feat[2];       /* [0] previous frame, [1] current: swapped by pointer */
     uint8_t *small;               /* downscaled luma */
     int small_w, small_h;
+    /* HOME's box downscale of planar rows (its backend's): the same rounding as the reference
+     * loop in registration_luma() */
+    void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
     stab_slot *ring;              /* 2 lookahead + 1 slots, frame n in ring[n % len] */
     int ring_len;
     long pushed, emitted;
@@ -187,6 +191,10 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     st->feat[0] = (home_features *)(void *)(base + l.feat);
     st->feat[1] = st->feat[0] + 1;
     memset(st->feat[0], 0, 2 * sizeof(home_features));
+    {
+        const home__kernels *k = home__kernels_for(h.simd);
+        st->box_down = (k ? k : &home__kernels_scalar)->box_down;
+    }
     st->small = base + l.small;
     st->small_w = h.width;
     st->small_h = h.height;
@@ -310,6 +318,13 @@ static const uint8_t *registration_luma(home_stab *st, const home_stab_image *im
     if (f == 1 && step == 1) {
         *stride = im->stride[0];
         return y;
+    }
+    if (step == 1) {
+        for (j = 0; j < st->small_h; j++)
+            st->box_down(y + (ptrdiff_t)(j * f) * im->stride[0], im->stride[0], f,
+                         st->small + (ptrdiff_t)j * st->small_w, st->small_w);
+        *stride = st->small_w;
+        return st->small;
     }
     for (j = 0; j < st->small_h; j++)
         for (i = 0; i < st->small_w; i++) {
