@@ -43,13 +43,14 @@ $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_inte
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_LIB) -c $< -o $@
 
-# The Hough transform's per-theta loops (J from the line sums, the lines' end pixels) and the
-# refinement's residual bins are plain element-wise loops that -O2's cheapest vectoriser leaves
-# scalar (0.4 M and 0.2 M instructions per video frame). Element-wise IEEE operations in C99
+# The Hough transform's per-theta loops (J from the line sums, the lines' end pixels), the
+# refinement's residual bins and the descriptors' radial profiles are plain element-wise loops
+# that -O2's cheapest vectoriser leaves scalar (0.4, 0.2 and 0.2 M instructions per video
+# frame). Element-wise IEEE operations in C99
 # mode (no contraction, no reassociation), so bit-identical output.
 # The line fit (src/homography.c) works on four matches per step in separate lanes, element-wise
 # too; its sqrt vectorises only without errno (-fno-math-errno: same IEEE square roots).
-$(BUILD)/obj/src/hough.o $(BUILD)/obj/src/refine.o: CFLAGS_LIB += -ftree-vectorize
+$(BUILD)/obj/src/hough.o $(BUILD)/obj/src/refine.o $(BUILD)/obj/src/describe.o: CFLAGS_LIB += -ftree-vectorize
 $(BUILD)/obj/src/homography.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno
 $(BUILD)/obj/port/avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 $(BUILD)/obj/port/%.o: port/%.c include/home.h include/home_limits.h port/kernels.h

@@ -6,23 +6,26 @@
 #include <math.h>
 
 /* J along the r axis at r0, r0 + 1, ..., r0 + 31 on the theta position t (relative to rows[0]),
- * bilinear; zero beyond the r axis. */
+ * bilinear; zero beyond the r axis. Each of the 33 columns is interpolated in theta once, then
+ * neighbours in r (branch-free loops, which the compiler vectorises). */
 static void radial_profile(const float *const *rows, float t, float r0, int r_bins, float *out)
 {
-    int t0 = (int)floorf(t), i0 = (int)floorf(r0), m;
-    float ft = t - (float)t0, fr = r0 - (float)i0;
+    int t0 = (int)floorf(t), i0 = (int)floorf(r0), m, lo, hi;
+    float ft = t - (float)t0, fr = r0 - (float)i0, col[2 * HOME_DESC_LEN + 1];
     const float *a, *b;
     if (t0 < 0) { t0 = 0; ft = 0.0f; }
     if (t0 > HOME__DESC_ROWS - 2) { t0 = HOME__DESC_ROWS - 2; ft = 1.0f; }
     a = rows[t0];
     b = rows[t0 + 1];
-    for (m = 0; m < 2 * HOME_DESC_LEN; m++) {
-        int i = i0 + m;
-        float v0 = 0.0f, v1 = 0.0f;
-        if (i >= 0 && i < r_bins) v0 = a[i] + ft * (b[i] - a[i]);
-        if (i + 1 >= 0 && i + 1 < r_bins) v1 = a[i + 1] + ft * (b[i + 1] - a[i + 1]);
-        out[m] = v0 + fr * (v1 - v0);
-    }
+    /* columns i0 + m inside [0, r_bins): m in [lo, hi) */
+    lo = i0 < 0 ? -i0 : 0;
+    hi = r_bins - i0 < 2 * HOME_DESC_LEN + 1 ? r_bins - i0 : 2 * HOME_DESC_LEN + 1;
+    if (lo > 2 * HOME_DESC_LEN + 1) lo = 2 * HOME_DESC_LEN + 1;
+    if (hi < lo) hi = lo;
+    for (m = 0; m < lo; m++) col[m] = 0.0f;
+    for (; m < hi; m++) col[m] = a[i0 + m] + ft * (b[i0 + m] - a[i0 + m]);
+    for (; m < 2 * HOME_DESC_LEN + 1; m++) col[m] = 0.0f;
+    for (m = 0; m < 2 * HOME_DESC_LEN; m++) out[m] = col[m] + fr * (col[m + 1] - col[m]);
 }
 
 /* rows[0..4] are smoothed rows centre-2 .. centre+2. The 2x32 patch centred on the keypoint
