@@ -180,7 +180,7 @@ typedef struct layout {
     int geom_longest, geom_blocks;
     size_t geom_intercepts;
     ptrdiff_t img_n_stride, img_t_stride;
-    size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, extrema, candidates, matches,
+    size_t ctx, grad_x, grad_y, acc_x, acc_y, raw_rows, smooth_rows, row_tmp, heap, heap_entries, extrema, candidates, matches,
         inliers, slots, refine, total;
     int max_matches;
 } layout;
@@ -277,6 +277,7 @@ static void plan(const home_config *cfg, layout *l)
     l->smooth_rows = take(&cur, HOME__DESC_ROWS * r_bins * sizeof(float));
     l->row_tmp = take(&cur, r_bins * sizeof(float));
     l->heap = take(&cur, 2 * (size_t)cfg->keypoints_per_sign * sizeof(home__candidate));
+    l->heap_entries = take(&cur, 2 * (size_t)cfg->keypoints_per_sign * sizeof(home__heap_entry));
     l->extrema = take(&cur, r_bins * sizeof(home__extremum));
     l->candidates = take(&cur, r_bins * sizeof(int));
     l->matches = take(&cur, (size_t)l->max_matches * sizeof(home__match));
@@ -364,6 +365,7 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
     ctx->smooth_rows = (float *)(void *)(base + l.smooth_rows);
     ctx->row_tmp = (float *)(void *)(base + l.row_tmp);
     ctx->heap_items = (home__candidate *)(void *)(base + l.heap);
+    ctx->heap_entries = (home__heap_entry *)(void *)(base + l.heap_entries);
     ctx->row_extrema = (home__extremum *)(void *)(base + l.extrema);
     ctx->row_candidates = (int *)(void *)(base + l.candidates);
     ctx->matches = (home__match *)(void *)(base + l.matches);

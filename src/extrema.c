@@ -4,33 +4,35 @@
 #include <math.h>
 
 /* Strict total order: higher saliency first, then earlier detection. */
-static int ranks_below(const home__candidate *a, const home__candidate *b)
+static int ranks_below(const home__heap_entry *a, const home__heap_entry *b)
 {
     if (a->saliency != b->saliency) return a->saliency < b->saliency;
     return a->order > b->order;
 }
 
-void home__heap_init(home__heap *heap, home__candidate *storage, int capacity)
+void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool, int capacity)
 {
-    heap->items = storage;
+    heap->entries = entries;
+    heap->pool = pool;
     heap->count = 0;
     heap->capacity = capacity;
 }
 
 int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t order)
 {
-    home__candidate probe;
+    home__heap_entry probe;
     if (heap->count < heap->capacity) return 1;
     probe.saliency = saliency;
     probe.order = order;
-    return ranks_below(&heap->items[0], &probe);
+    probe.slot = 0;
+    return ranks_below(&heap->entries[0], &probe);
 }
 
-static void sift_down(home__candidate *items, int count, int i)
+static void sift_down(home__heap_entry *items, int count, int i)
 {
     for (;;) {
         int l = 2 * i + 1, r = l + 1, m = i;
-        home__candidate tmp;
+        home__heap_entry tmp;
         if (l < count && ranks_below(&items[l], &items[m])) m = l;
         if (r < count && ranks_below(&items[r], &items[m])) m = r;
         if (m == i) return;
@@ -39,34 +41,41 @@ static void sift_down(home__candidate *items, int count, int i)
     }
 }
 
-/* Insert, or replace the weakest when full (callers check home__heap_would_accept first). */
+/* Insert, or replace the weakest when full (callers check home__heap_would_accept first); the
+ * weakest's pool slot takes the newcomer. */
 void home__heap_push(home__heap *heap, const home__candidate *cand)
 {
+    home__heap_entry e;
+    e.saliency = cand->saliency;
+    e.order = cand->order;
     if (heap->count < heap->capacity) {
         int i = heap->count++;
-        heap->items[i] = *cand;
+        e.slot = i;
+        heap->pool[i] = *cand;
+        heap->entries[i] = e;
         while (i > 0) {
             int parent = (i - 1) / 2;
-            home__candidate tmp;
-            if (!ranks_below(&heap->items[i], &heap->items[parent])) break;
-            tmp = heap->items[i]; heap->items[i] = heap->items[parent]; heap->items[parent] = tmp;
+            home__heap_entry tmp;
+            if (!ranks_below(&heap->entries[i], &heap->entries[parent])) break;
+            tmp = heap->entries[i]; heap->entries[i] = heap->entries[parent]; heap->entries[parent] = tmp;
             i = parent;
         }
-    } else if (ranks_below(&heap->items[0], cand)) {
-        heap->items[0] = *cand;
-        sift_down(heap->items, heap->count, 0);
+    } else if (ranks_below(&heap->entries[0], &e)) {
+        e.slot = heap->entries[0].slot;
+        heap->pool[e.slot] = *cand;
+        heap->entries[0] = e;
+        sift_down(heap->entries, heap->count, 0);
     }
 }
 
-/* In-place heap sort; afterwards items[0] is the most salient. Returns the count. */
 int home__heap_sort_desc(home__heap *heap)
 {
     int n;
     for (n = heap->count - 1; n > 0; n--) {
-        home__candidate tmp = heap->items[0];
-        heap->items[0] = heap->items[n];
-        heap->items[n] = tmp;
-        sift_down(heap->items, n, 0);
+        home__heap_entry tmp = heap->entries[0];
+        heap->entries[0] = heap->entries[n];
+        heap->entries[n] = tmp;
+        sift_down(heap->entries, n, 0);
     }
     return heap->count;
 }

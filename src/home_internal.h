@@ -20,8 +20,17 @@ typedef struct home__candidate {
     float samples[HOME_DESC_LEN];
 } home__candidate;
 
+/* A fixed-capacity min-heap of candidates: the ordering moves small entries (rank and the pool
+ * slot of the candidate), the candidates themselves stay where they were written */
+typedef struct home__heap_entry {
+    float saliency;
+    uint32_t order;
+    int slot;                         /* index into the pool */
+} home__heap_entry;
+
 typedef struct home__heap {
-    home__candidate *items;
+    home__heap_entry *entries;        /* capacity */
+    home__candidate *pool;            /* capacity */
     int count, capacity;
 } home__heap;
 
@@ -103,6 +112,7 @@ struct home_context {
     float *smooth_rows;               /* ring of HOME__DESC_ROWS fully smoothed rows */
     float *row_tmp;                   /* r_bins scratch */
     home__candidate *heap_items;      /* 2 * keypoints_per_sign */
+    home__heap_entry *heap_entries;   /* 2 * keypoints_per_sign */
     home__extremum *row_extrema;      /* r_bins: extrema of one theta row */
     int *row_candidates;              /* r_bins: their candidate bins (extremum_candidates) */
     home__match *matches;             /* capacity max_matches */
@@ -150,9 +160,11 @@ void home__smooth_r(const home__kernels *kernels, const float *in, float *out, i
                     const float *taps, int radius);
 
 /* extrema.c */
-void home__heap_init(home__heap *heap, home__candidate *storage, int capacity);
+void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool, int capacity);
 int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t order);
 void home__heap_push(home__heap *heap, const home__candidate *cand);
+/* Sorts the entries, most salient first; the i-th is then &pool[entries[i].slot]. Returns the
+ * count. */
 int home__heap_sort_desc(home__heap *heap);
 /* Scan smoothed row rows[1] (rows[0..2] = centre-1 .. centre+1) for strict extrema with a valid
  * Newton step whose refined theta lies in [0, theta_bins); returns how many were written.

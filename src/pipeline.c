@@ -87,7 +87,7 @@ static void fill_keypoints(const home_context *ctx, home__heap *heap, int sign, 
     const float centre_bin = 0.5f * (float)(ctx->r_bins - 1);
     int i, n = home__heap_sort_desc(heap);
     for (i = 0; i < n; i++) {
-        const home__candidate *c = &heap->items[i];
+        const home__candidate *c = &heap->pool[heap->entries[i].slot];
         home_keypoint *kp = &out[i];
         kp->theta = (float)(c->theta_bin * (HOME__PI / n_theta));
         if (kp->theta >= (float)HOME__PI) kp->theta = nextafterf((float)HOME__PI, 0.0f); /* [0, pi) */
@@ -122,9 +122,9 @@ int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home
     memset(&st, 0, sizeof st);
     st.ctx = ctx;
     st.detect = 1;
-    home__heap_init(&st.pos, ctx->heap_items, ctx->cfg.keypoints_per_sign);
-    home__heap_init(&st.neg, ctx->heap_items + ctx->cfg.keypoints_per_sign,
-                    ctx->cfg.keypoints_per_sign);
+    home__heap_init(&st.pos, ctx->heap_entries, ctx->heap_items, ctx->cfg.keypoints_per_sign);
+    home__heap_init(&st.neg, ctx->heap_entries + ctx->cfg.keypoints_per_sign,
+                    ctx->heap_items + ctx->cfg.keypoints_per_sign, ctx->cfg.keypoints_per_sign);
     out->ms_hough = home__hough_stream(ctx, image, stride, on_row, &st);
 
     n_values = (double)ctx->cfg.theta_bins * ctx->r_bins;

@@ -114,12 +114,13 @@ void test_hough_geometry_cache(void)
 void test_heap_keeps_top_k(void)
 {
     static home__candidate store[37];
+    static home__heap_entry entries[37];
     home__heap heap;
     float saliency[500];
     int i, k;
     synth_rng rng;
     synth_seed(&rng, 5);
-    home__heap_init(&heap, store, 37);
+    home__heap_init(&heap, entries, store, 37);
     for (i = 0; i < 500; i++) {
         home__candidate c;
         memset(&c, 0, sizeof c);
@@ -135,7 +136,7 @@ void test_heap_keeps_top_k(void)
         int best = -1;
         for (i = 0; i < 500; i++)
             if (saliency[i] >= 0 && (best < 0 || saliency[i] > saliency[best])) best = i;
-        CHECK_EQ_INT((int)store[k].theta_bin, best);
+        CHECK_EQ_INT((int)store[entries[k].slot].theta_bin, best);
         saliency[best] = -1;
     }
 }
