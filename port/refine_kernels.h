@@ -11,6 +11,9 @@
 #define HOME__REFINE_LANES 4
 #define HOME__REFINE_ACC 44   /* 36 upper-triangle entries of J^T W J, then 8 of J^T W r */
 
+/* Bytes readable past the last pixel of an image the warp samples (the pyramid levels have them). */
+#define HOME__REFINE_IMAGE_SLACK 4
+
 typedef struct home__refine_kernels {
     const char *name;
     /* 3x3 binomial blur ([1 2 1] / 4 both ways, one rounding: (sum + 8) >> 4), edges
@@ -31,7 +34,8 @@ typedef struct home__refine_kernels {
     void (*block_max)(const int16_t *keys, int n, int b, uint16_t *cells);
     /* Bilinear samples at m * (x, y, 1) after the perspective divide (one reciprocal 1 / d, then
      * two products), -1 where the point maps behind the camera or its 2x2 support leaves the
-     * w x h image. n is a multiple of 4. */
+     * w x h image. n is a multiple of 4. img may be read up to HOME__REFINE_IMAGE_SLACK bytes
+     * past its last pixel (whole-word gathers). */
     void (*warp)(const float *m, const int16_t *xs, const int16_t *ys, int n, const uint8_t *img,
                  ptrdiff_t stride, int w, int h, float *out);
     /* Weighted normal equations of one inverse-compositional step, per lane:

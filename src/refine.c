@@ -120,7 +120,7 @@ size_t home__refine_bytes(const home_config *cfg)
     size_t total = 0;
     int l, n = cfg->refine_levels ? levels_for(cfg) : 0;
     for (l = 0; l < n; l++) {
-        total += align64((size_t)(cfg->width >> l) * (size_t)(cfg->height >> l));
+        total += align64((size_t)(cfg->width >> l) * (size_t)(cfg->height >> l) + HOME__REFINE_IMAGE_SLACK);
         total += 2 * 5 * align64((size_t)(level_capacity(cfg, l) + LANES) * sizeof(int16_t));
     }
     if (n) total += align64(scratch_bytes(cfg));
@@ -139,7 +139,7 @@ void home__refine_init(home_context *ctx, unsigned char *block)
         st->w[l] = ctx->cfg.width >> l;
         st->h[l] = ctx->cfg.height >> l;
         st->pyr[l] = block;
-        block += align64((size_t)st->w[l] * (size_t)st->h[l]);
+        block += align64((size_t)st->w[l] * (size_t)st->h[l] + HOME__REFINE_IMAGE_SLACK);
         for (s = 0; s < 2; s++) {
             home__refine_points *p = &st->tpl[s][l];
             size_t bytes = align64((size_t)(level_capacity(&ctx->cfg, l) + LANES) * sizeof(int16_t));
