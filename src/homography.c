@@ -22,7 +22,7 @@ typedef struct line_problem {
 /* The fit runs over FIT_LANES matches at a time: each lane is one line's arithmetic and has its
  * own partial sums, added in a fixed order at the end, so the result is the same on every
  * target; written as loops over lanes, which the compiler turns into vector arithmetic. */
-#define FIT_LANES 4
+#define FIT_LANES 4 /* the final sums combine exactly four lanes: (0 + 1) + (2 + 3) */
 
 typedef struct line_lanes {
     double e[3][FIT_LANES];  /* residual, Hough bins */
