@@ -6,6 +6,8 @@
 //   HOME pair: both images (home_register), per stage;
 //   ORB frame: ORB(2000).detectAndCompute on the new frame + BFMatcher knn ratio 0.75 against
 //     the previous frame's cached descriptors + findHomography(RANSAC).
+//   Head to head: the ORB frame and the HOME video frame (home_video_config, the automatic
+//     backend) timed alternately, 5x runs of each, so load on a shared machine hits both alike.
 // Prints a table and the ratios; usage: home-bench [runs]
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -32,6 +34,17 @@ static double median(std::vector<double> v) {
 
 struct HomeTimes { double frame, stage[HOME_STAGE_COUNT], pair_total; double err; size_t arena; };
 
+// A HOME context on its own arena.
+struct HomeContext {
+    size_t bytes;
+    std::vector<unsigned char> mem;
+    home_context *ctx = nullptr;
+    explicit HomeContext(const home_config &cfg) : bytes(home_arena_size(&cfg)), mem(bytes + HOME_ARENA_ALIGN) {
+        void *arena = (void *)(((uintptr_t)mem.data() + HOME_ARENA_ALIGN - 1) & ~(uintptr_t)(HOME_ARENA_ALIGN - 1));
+        if (home_init(&ctx, &cfg, arena, bytes, NULL) != HOME_OK) ctx = nullptr;
+    }
+};
+
 // preset 0: defaults with refinement; 1: defaults without; 2: home_video_config (Hough of a
 // ~160 px wide box-downscaled frame, 240 theta bins, theta window, refinement at full size)
 static const char *preset_name[] = {"default", "no-refine", "video"};
@@ -45,11 +58,10 @@ static bool time_home(int simd, int preset, int w, int h, const std::vector<uint
     if (preset == 1) cfg.refine_levels = 0;
     cfg.clock = now_ms;
     if (home_validate_config(&cfg) != HOME_OK) return false;
-    out.arena = home_arena_size(&cfg);
-    std::vector<unsigned char> mem(out.arena + HOME_ARENA_ALIGN);
-    void *arena = (void *)(((uintptr_t)mem.data() + HOME_ARENA_ALIGN - 1) & ~(uintptr_t)(HOME_ARENA_ALIGN - 1));
-    home_context *ctx;
-    if (home_init(&ctx, &cfg, arena, out.arena, NULL) != HOME_OK) return false;
+    HomeContext home(cfg);
+    home_context *ctx = home.ctx;
+    if (!ctx) return false;
+    out.arena = home.bytes;
     static home_features fa, fb;
     home_result res;
     std::vector<double> frame, total, stage[HOME_STAGE_COUNT];
@@ -72,17 +84,15 @@ static bool time_home(int simd, int preset, int w, int h, const std::vector<uint
     return true;
 }
 
-static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::vector<uint8_t> &b,
-                       const double *truth, int runs, double &err) {
-    cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data());
-    auto orb = cv::ORB::create(2000);
-    cv::BFMatcher bf(cv::NORM_HAMMING);
+// ORB(2000) + BFMatcher knn ratio 0.75 + findHomography(RANSAC) against cached features of A.
+struct OrbPipeline {
+    cv::Ptr<cv::ORB> orb = cv::ORB::create(2000);
+    cv::BFMatcher bf{cv::NORM_HAMMING};
     std::vector<cv::KeyPoint> ka, kb;
-    cv::Mat da, db, H;
-    orb->detectAndCompute(ma, cv::noArray(), ka, da);
-    std::vector<double> t;
-    for (int i = 0; i < runs; i++) {
-        double t0 = now_ms(nullptr);
+    cv::Mat da, db;
+    explicit OrbPipeline(const cv::Mat &ma) { orb->detectAndCompute(ma, cv::noArray(), ka, da); }
+    // one new frame: features, matches against A's, homography (A -> B), empty if too few
+    cv::Mat frame(const cv::Mat &mb) {
         orb->detectAndCompute(mb, cv::noArray(), kb, db);
         std::vector<std::vector<cv::DMatch>> knn;
         bf.knnMatch(da, db, knn, 2);
@@ -92,7 +102,18 @@ static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::v
                 src.push_back(ka[m[0].queryIdx].pt);
                 dst.push_back(kb[m[0].trainIdx].pt);
             }
-        H = src.size() >= 4 ? cv::findHomography(src, dst, cv::RANSAC) : cv::Mat();
+        return src.size() >= 4 ? cv::findHomography(src, dst, cv::RANSAC) : cv::Mat();
+    }
+};
+
+static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::vector<uint8_t> &b,
+                       const double *truth, int runs, double &err) {
+    cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data()), H;
+    OrbPipeline orb(ma);
+    std::vector<double> t;
+    for (int i = 0; i < runs; i++) {
+        double t0 = now_ms(nullptr);
+        H = orb.frame(mb);
         t.push_back(now_ms(nullptr) - t0);
     }
     err = -1;
@@ -102,6 +123,34 @@ static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::v
         err = synth_corner_error(he, truth, w, h);
     }
     return median(t);
+}
+
+// The ORB frame and HOME's video frame alternately, runs times each: medians of both.
+static bool head_to_head(int w, int h, const std::vector<uint8_t> &a, const std::vector<uint8_t> &b,
+                         int runs, double &orb_ms, double &home_ms, const char **backend) {
+    cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data());
+    OrbPipeline orb(ma);
+    home_config cfg;
+    home_video_config(&cfg, w, h);
+    HomeContext home(cfg);
+    if (!home.ctx) return false;
+    *backend = home_simd_backend(home.ctx);
+    static home_features fa, fb;
+    home_result res;
+    std::vector<double> t_orb, t_home;
+    for (int i = 0; i < runs; i++) {
+        double t0 = now_ms(nullptr);
+        orb.frame(mb);
+        t_orb.push_back(now_ms(nullptr) - t0);
+        home_extract(home.ctx, a.data(), w, &fa);  // the previous frame, cached (not timed)
+        t0 = now_ms(nullptr);
+        home_extract(home.ctx, b.data(), w, &fb);
+        home_match(home.ctx, &fa, &fb, &res);
+        t_home.push_back(now_ms(nullptr) - t0);
+    }
+    orb_ms = median(t_orb);
+    home_ms = median(t_home);
+    return true;
 }
 
 // Only the per-frame work, n times, for instruction counting under callgrind:
@@ -135,11 +184,9 @@ static int count_frames(const char *method, int n, int downscale, int window, fl
     if (t0 > 0) cfg.threshold_start = t0;
     if (theta_bins > 0) cfg.theta_bins = theta_bins;
     if (keypoints > 0) cfg.keypoints_per_sign = keypoints;
-    size_t bytes = home_arena_size(&cfg);
-    std::vector<unsigned char> mem(bytes + HOME_ARENA_ALIGN);
-    void *arena = (void *)(((uintptr_t)mem.data() + HOME_ARENA_ALIGN - 1) & ~(uintptr_t)(HOME_ARENA_ALIGN - 1));
-    home_context *ctx;
-    if (home_init(&ctx, &cfg, arena, bytes, NULL) != HOME_OK) return 1;
+    HomeContext home(cfg);
+    home_context *ctx = home.ctx;
+    if (!ctx) return 1;
     static home_features fa, fb;
     home_result res;
     // a video alternating between the two frames: each step extracts one new frame and
@@ -197,6 +244,12 @@ int main(int argc, char **argv) {
                        t.stage[HOME_STAGE_MATCH], t.stage[HOME_STAGE_HOMOGRAPHY], t.stage[HOME_STAGE_REFINE],
                        t.stage[HOME_STAGE_TOTAL], t.arena);
             }
+        double h2h_orb, h2h_home;
+        const char *backend = "";
+        if (head_to_head(w, h, a, b, 5 * runs, h2h_orb, h2h_home, &backend))
+            printf("head to head (alternating, %d runs each): ORB frame %.2f ms, HOME video frame (%s) "
+                   "%.2f ms: ORB/HOME %.2f\n",
+                   5 * runs, h2h_orb, backend, h2h_home, h2h_orb / h2h_home);
         printf("\n");
     }
     return 0;
