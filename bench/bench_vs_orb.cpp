@@ -6,8 +6,9 @@
 //   HOME pair: both images (home_register), per stage;
 //   ORB frame: ORB(2000).detectAndCompute on the new frame + BFMatcher knn ratio 0.75 against
 //     the previous frame's cached descriptors + findHomography(RANSAC).
-//   Head to head: the ORB frame and the HOME video frame (home_video_config, the automatic
-//     backend) timed alternately, 5x runs of each, so load on a shared machine hits both alike.
+//   Head to head: the ORB frame and the HOME video frames (home_video_config, and the same
+//     with the refinement ending at half size; the automatic backend) timed in rotation, 5x
+//     runs of each, so load on a shared machine hits all alike.
 // Prints a table and the ratios; usage: home-bench [runs]
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -46,16 +47,23 @@ struct HomeContext {
 };
 
 // preset 0: defaults with refinement; 1: defaults without; 2: home_video_config (Hough of a
-// ~160 px wide box-downscaled frame, 240 theta bins, theta window, refinement at full size)
-static const char *preset_name[] = {"default", "no-refine", "video"};
+// ~160 px wide box-downscaled frame, 120 theta bins, theta window, refinement at full size);
+// 3: the video preset with the refinement ending at half size (refine_finest_level = 1)
+static const char *preset_name[] = {"default", "no-refine", "video", "video-half"};
+enum { N_PRESETS = 4 };
+
+static void preset_config(int preset, int w, int h, home_config &cfg) {
+    if (preset >= 2) home_video_config(&cfg, w, h);
+    else home_default_config(&cfg, w, h);
+    if (preset == 1) cfg.refine_levels = 0;
+    if (preset == 3) cfg.refine_finest_level = 1;
+}
 
 static bool time_home(int simd, int preset, int w, int h, const std::vector<uint8_t> &a,
                       const std::vector<uint8_t> &b, const double *truth, int runs, HomeTimes &out) {
     home_config cfg;
-    if (preset == 2) home_video_config(&cfg, w, h);
-    else home_default_config(&cfg, w, h);
+    preset_config(preset, w, h, cfg);
     cfg.simd = simd;
-    if (preset == 1) cfg.refine_levels = 0;
     cfg.clock = now_ms;
     if (home_validate_config(&cfg) != HOME_OK) return false;
     HomeContext home(cfg);
@@ -125,37 +133,44 @@ static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::v
     return median(t);
 }
 
-// The ORB frame and HOME's video frame alternately, runs times each: medians of both.
+// The ORB frame and HOME's two video frames (presets 2 and 3) in rotation, runs times each:
+// medians of all three.
 static bool head_to_head(int w, int h, const std::vector<uint8_t> &a, const std::vector<uint8_t> &b,
-                         int runs, double &orb_ms, double &home_ms, const char **backend) {
+                         int runs, double &orb_ms, double *home_ms, const char **backend) {
     cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data());
     OrbPipeline orb(ma);
-    home_config cfg;
-    home_video_config(&cfg, w, h);
-    HomeContext home(cfg);
-    if (!home.ctx) return false;
-    *backend = home_simd_backend(home.ctx);
+    home_config cfg[2];
+    preset_config(2, w, h, cfg[0]);
+    preset_config(3, w, h, cfg[1]);
+    HomeContext home0(cfg[0]), home1(cfg[1]);
+    HomeContext *home[2] = {&home0, &home1};
+    if (!home0.ctx || !home1.ctx) return false;
+    *backend = home_simd_backend(home0.ctx);
     static home_features fa, fb;
     home_result res;
-    std::vector<double> t_orb, t_home;
+    std::vector<double> t_orb, t_home[2];
     for (int i = 0; i < runs; i++) {
         double t0 = now_ms(nullptr);
         orb.frame(mb);
         t_orb.push_back(now_ms(nullptr) - t0);
-        home_extract(home.ctx, a.data(), w, &fa);  // the previous frame, cached (not timed)
-        t0 = now_ms(nullptr);
-        home_extract(home.ctx, b.data(), w, &fb);
-        home_match(home.ctx, &fa, &fb, &res);
-        t_home.push_back(now_ms(nullptr) - t0);
+        for (int k = 0; k < 2; k++) {
+            home_context *ctx = home[k]->ctx;
+            home_extract(ctx, a.data(), w, &fa);  // the previous frame, cached (not timed)
+            t0 = now_ms(nullptr);
+            home_extract(ctx, b.data(), w, &fb);
+            home_match(ctx, &fa, &fb, &res);
+            t_home[k].push_back(now_ms(nullptr) - t0);
+        }
     }
     orb_ms = median(t_orb);
-    home_ms = median(t_home);
+    home_ms[0] = median(t_home[0]);
+    home_ms[1] = median(t_home[1]);
     return true;
 }
 
 // Only the per-frame work, n times, for instruction counting under callgrind:
-//   home-bench --frames orb|video|home N [downscale [theta_window [threshold_start [theta_bins [keypoints]]]]]
-// (video: home_video_config; home: the defaults with the given overrides)
+//   home-bench --frames orb|video|video-half|home N [downscale [theta_window [threshold_start [theta_bins [keypoints]]]]]
+// (video: home_video_config; video-half: the same, refinement ending at half size; home: the defaults with the given overrides)
 static int count_frames(const char *method, int n, int downscale, int window, float t0, int theta_bins,
                         int keypoints) {
     const int w = 640, h = 360;
@@ -172,8 +187,8 @@ static int count_frames(const char *method, int n, int downscale, int window, fl
         return 0;
     }
     home_config cfg;
-    if (std::string(method) == "video") {
-        home_video_config(&cfg, w, h);
+    if (std::string(method) == "video" || std::string(method) == "video-half") {
+        preset_config(std::string(method) == "video" ? 2 : 3, w, h, cfg);
         downscale = cfg.hough_downscale;
         window = cfg.match_theta_window;
     } else {
@@ -235,7 +250,7 @@ int main(int argc, char **argv) {
                "preset", "frame", "ORB/HOME", "err", "hough", "detect", "describe", "match", "homog",
                "refine", "total", "arena", "");
         for (auto &bk : backends)
-            for (int preset = 0; preset < 3; preset++) {
+            for (int preset = 0; preset < N_PRESETS; preset++) {
                 HomeTimes t;
                 if (!time_home(bk.simd, preset, w, h, a, b, hwarp, runs, t)) continue;
                 printf("%-8s %-9s %8.2f %8.2f %6.3f | %19.2f %7.2f %8.2f %6.2f %6.2f %6.2f %7.2f | %8zu\n",
@@ -244,12 +259,13 @@ int main(int argc, char **argv) {
                        t.stage[HOME_STAGE_MATCH], t.stage[HOME_STAGE_HOMOGRAPHY], t.stage[HOME_STAGE_REFINE],
                        t.stage[HOME_STAGE_TOTAL], t.arena);
             }
-        double h2h_orb, h2h_home;
+        double h2h_orb, h2h_home[2];
         const char *backend = "";
         if (head_to_head(w, h, a, b, 5 * runs, h2h_orb, h2h_home, &backend))
-            printf("head to head (alternating, %d runs each): ORB frame %.2f ms, HOME video frame (%s) "
-                   "%.2f ms: ORB/HOME %.2f\n",
-                   5 * runs, h2h_orb, backend, h2h_home, h2h_orb / h2h_home);
+            printf("head to head (in rotation, %d runs each, %s): ORB frame %.2f ms; HOME video frame "
+                   "%.2f ms, ORB/HOME %.2f; video-half frame %.2f ms, ORB/HOME %.2f\n",
+                   5 * runs, backend, h2h_orb, h2h_home[0], h2h_orb / h2h_home[0], h2h_home[1],
+                   h2h_orb / h2h_home[1]);
         printf("\n");
     }
     return 0;

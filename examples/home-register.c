@@ -49,6 +49,8 @@ static void usage(FILE *f)
         "  --refine-iterations N  Gauss-Newton iteration cap per level (default 10)\n"
         "  --refine-points N    refinement template points at full size, halved per level\n"
         "                       (default 4096, 64..4096)\n"
+        "  --refine-finest L    pyramid level the refinement ends at: 0 full size (default),\n"
+        "                       1 half size (about half the refinement's cost)\n"
         "  --refine-trust PX    largest corner motion the refinement may make, in Hough-image\n"
         "                       px (default 6)\n"
         "  --repeat N           register N times; ms are medians, plus \"frame\": one new frame\n"
@@ -140,7 +142,7 @@ int main(int argc, char **argv)
     home_config cfg;
     int n_paths = 0, i, repeat = 1, status, s, video = 0;
     int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_rpoints = -1, opt_downscale = -1,
-        opt_window = -1;
+        opt_window = -1, opt_rfinest = -1;
     float opt_rtrust = -1;
     float opt_ratio = -1, opt_thr = -1, opt_thr0 = -1, opt_rstep = -1, opt_sigma = -1;
     uint8_t *buf_a = NULL, *buf_b = NULL;
@@ -168,6 +170,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--refine-levels")) bad = parse_int(v, &opt_rlevels), i++;
         else if (!strcmp(a, "--refine-iterations")) bad = parse_int(v, &opt_riters), i++;
         else if (!strcmp(a, "--refine-points")) bad = parse_int(v, &opt_rpoints), i++;
+        else if (!strcmp(a, "--refine-finest")) bad = parse_int(v, &opt_rfinest), i++;
         else if (!strcmp(a, "--refine-trust")) bad = parse_float(v, &opt_rtrust), i++;
         else if (!strcmp(a, "--repeat")) bad = parse_int(v, &repeat) || repeat < 1 || repeat > 10000, i++;
         else if (!strcmp(a, "--ratio")) bad = parse_float(v, &opt_ratio), i++;
@@ -211,6 +214,7 @@ int main(int argc, char **argv)
     if (opt_rlevels >= 0) cfg.refine_levels = opt_rlevels;
     if (opt_riters >= 0) cfg.refine_iterations = opt_riters;
     if (opt_rpoints >= 0) cfg.refine_points = opt_rpoints;
+    if (opt_rfinest >= 0) cfg.refine_finest_level = opt_rfinest;
     if (opt_rtrust >= 0) cfg.refine_trust_px = opt_rtrust;
     if (cfg.wrap_band > cfg.theta_bins / 4) cfg.wrap_band = cfg.theta_bins / 18;
     cfg.clock = clock_ms;

@@ -89,6 +89,9 @@ typedef struct home_config {
     int refine_points;        /* template points at full resolution (halved per coarser level,
                                  at least 64), 64..HOME_REFINE_MAX_POINTS; default the maximum
                                  (4096): fewer cost proportionally less per iteration */
+    int refine_finest_level;  /* pyramid level the refinement ends at: 0 = full resolution
+                                 (default); 1 = half: no full-size point selection or
+                                 iterations (~2x faster refinement, about twice the error) */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
     int hough_downscale;      /* 1: Hough transform of the image itself; 2 or 4: of its 2x2- or

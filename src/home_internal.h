@@ -58,6 +58,7 @@ typedef struct home__refine_points {
  * pyramid of the last one */
 typedef struct home__refine_state {
     int levels;                       /* 0: refinement off */
+    int finest_level;                 /* the finest level points are selected at */
     int w[HOME_REFINE_MAX_LEVELS], h[HOME_REFINE_MAX_LEVELS];
     uint8_t *pyr[HOME_REFINE_MAX_LEVELS];
     uint32_t pyr_id, slot_id[2];

@@ -69,6 +69,7 @@ void home__refine_defaults(home_config *cfg)
     cfg->refine_iterations = 10;
     cfg->refine_trust_px = 6.0f;
     cfg->refine_points = HOME_REFINE_MAX_POINTS;
+    cfg->refine_finest_level = 0;
 }
 
 int home__refine_validate(const home_config *cfg)
@@ -78,6 +79,8 @@ int home__refine_validate(const home_config *cfg)
     if (cfg->refine_iterations < 1 || cfg->refine_iterations > HOME_REFINE_MAX_ITERS)
         return HOME_E_CONFIG;
     if (cfg->refine_points < 64 || cfg->refine_points > HOME_REFINE_MAX_POINTS) return HOME_E_CONFIG;
+    if (cfg->refine_finest_level < 0 || cfg->refine_finest_level >= cfg->refine_levels)
+        return HOME_E_CONFIG;
     if (!(isfinite(cfg->refine_trust_px) && cfg->refine_trust_px >= 0.05f &&
           cfg->refine_trust_px <= 256.0f))
         return HOME_E_CONFIG;
@@ -103,11 +106,17 @@ static size_t blocks_at(const home_config *cfg, int level)
 
 /* Scratch: per-point floats at match time (two warps, residuals, weights), or at extraction
  * time a row of int16 for the blur and a row of selection keys, then the block cells. */
+static int finest_for(const home_config *cfg)
+{
+    const int levels = levels_for(cfg);
+    return cfg->refine_finest_level < levels ? cfg->refine_finest_level : levels - 1;
+}
+
 static size_t scratch_bytes(const home_config *cfg)
 {
-    size_t match = 4 * (size_t)level_capacity(cfg, 0) * sizeof(float), sel = 0;
+    size_t match = 4 * (size_t)level_capacity(cfg, finest_for(cfg)) * sizeof(float), sel = 0;
     int l;
-    for (l = 0; l < levels_for(cfg); l++) {
+    for (l = finest_for(cfg); l < levels_for(cfg); l++) {
         size_t s = blocks_at(cfg, l) * sizeof(uint16_t);
         if (s > sel) sel = s;
     }
@@ -121,7 +130,8 @@ size_t home__refine_bytes(const home_config *cfg)
     int l, n = cfg->refine_levels ? levels_for(cfg) : 0;
     for (l = 0; l < n; l++) {
         total += align64((size_t)(cfg->width >> l) * (size_t)(cfg->height >> l) + HOME__REFINE_IMAGE_SLACK);
-        total += 2 * 5 * align64((size_t)(level_capacity(cfg, l) + LANES) * sizeof(int16_t));
+        if (l >= finest_for(cfg)) /* no template below the finest level */
+            total += 2 * 5 * align64((size_t)(level_capacity(cfg, l) + LANES) * sizeof(int16_t));
     }
     if (n) total += align64(scratch_bytes(cfg));
     return total;
@@ -133,6 +143,7 @@ void home__refine_init(home_context *ctx, unsigned char *block)
     int l, s;
     memset(st, 0, sizeof *st);
     st->levels = ctx->cfg.refine_levels ? levels_for(&ctx->cfg) : 0;
+    st->finest_level = st->levels ? finest_for(&ctx->cfg) : 0;
     st->rk = home__refine_kernels_for(ctx->cfg.simd);
     if (!st->rk) st->rk = &home__refine_kernels_scalar; /* every backend gives the same result */
     for (l = 0; l < st->levels; l++) {
@@ -140,7 +151,7 @@ void home__refine_init(home_context *ctx, unsigned char *block)
         st->h[l] = ctx->cfg.height >> l;
         st->pyr[l] = block;
         block += align64((size_t)st->w[l] * (size_t)st->h[l] + HOME__REFINE_IMAGE_SLACK);
-        for (s = 0; s < 2; s++) {
+        for (s = 0; s < 2 && l >= st->finest_level; s++) {
             home__refine_points *p = &st->tpl[s][l];
             size_t bytes = align64((size_t)(level_capacity(&ctx->cfg, l) + LANES) * sizeof(int16_t));
             p->capacity = level_capacity(&ctx->cfg, l);
@@ -277,7 +288,7 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     st->pyr_id = hash_bytes(st->pyr[l], (size_t)st->w[l] * (size_t)st->h[l]);
     slot = st->next_slot;
     st->next_slot ^= 1;
-    for (l = 0; l < st->levels; l++)
+    for (l = st->finest_level; l < st->levels; l++)
         select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
     st->slot_id[slot] = st->pyr_id;
     return st->pyr_id;
@@ -624,7 +635,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0;
     int level, it, converged = 0, iterations = 0;
     float *scratch = (float *)st->scratch;
-    const int cap = level_capacity(&ctx->cfg, 0);
+    const int cap = level_capacity(&ctx->cfg, st->finest_level);
 
     memset(&s, 0, sizeof s);
     s.st = st;
@@ -640,7 +651,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     s.hessian_level = -1;
     to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
-    for (s.finest = 0; s.finest < st->levels - 1; s.finest++)
+    for (s.finest = st->finest_level; s.finest < st->levels - 1; s.finest++)
         if (s.tpl[s.finest].n >= FINEST_MIN_POINTS) break;
     for (level = s.finest; level < st->levels; level++) {
         if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return; }

@@ -182,6 +182,8 @@ static int y4m(const char *text, size_t size, int frames)
     X(refine_iterations_zero, HOME_E_CONFIG, (bad.refine_iterations = 0, home_validate_config(&bad))) \
     X(refine_trust_nan, HOME_E_CONFIG, (bad.refine_trust_px = (float)NAN, home_validate_config(&bad))) \
     X(refine_points_above_max, HOME_E_CONFIG, (bad.refine_points = HOME_REFINE_MAX_POINTS + 1, home_validate_config(&bad))) \
+    X(refine_finest_negative, HOME_E_CONFIG, (bad.refine_finest_level = -1, home_validate_config(&bad))) \
+    X(refine_finest_not_below_levels, HOME_E_CONFIG, (bad.refine_finest_level = bad.refine_levels, home_validate_config(&bad))) \
     X(simd_unknown, HOME_E_CONFIG, (bad.simd = 99, home_validate_config(&bad))) \
     X(hough_method_unknown, HOME_E_CONFIG, (bad.hough_method = 7, home_validate_config(&bad))) \
     X(arena_size_null, 0, (int)home_arena_size(NULL)) \

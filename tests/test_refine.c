@@ -153,6 +153,38 @@ void test_point_budget(void)
     CHECK(ctx->refine.tpl[0][0].n > cfg.refine_points / 2);
 }
 
+/* The refinement ending at half size (refine_finest_level = 1): no full-size template points
+ * are selected, and it still lands within 0.1 px from 2 px off (the full-size one: ~0.03). */
+void test_finest_level_half(void)
+{
+    home_config cfg;
+    int k;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.refine_finest_level = 1;
+    {
+        home_config full_cfg;
+        home_default_config(&full_cfg, IMG_W, IMG_H);
+        CHECK(home_arena_size(&cfg) < home_arena_size(&full_cfg)); /* no full-size template */
+    }
+    for (k = 0; k < 2; k++) {
+        double h[9], err_half, err_full;
+        home_result res;
+        home_context *ctx = context(NULL); /* one arena: full size first, then half */
+        if (!ctx) { CHECK(0); return; }
+        textured_pair(100 + k, 10 + 15 * k, 1.0, h);
+        err_full = refine_from(ctx, h, 2.0, 7 + k, &res);
+        ctx = context(&cfg);
+        if (!ctx) { CHECK(0); return; }
+        err_half = refine_from(ctx, h, 2.0, 7 + k, &res);
+        printf("     textured p=%d: start 2 px off -> %.3f px ending at half size, %.3f px at full, "
+               "%d iterations\n", 10 + 15 * k, err_half, err_full, res.refine_iterations);
+        CHECK(res.refined);
+        CHECK_EQ_INT(ctx->refine.tpl[0][0].n + ctx->refine.tpl[1][0].n, 0);
+        CHECK(ctx->refine.tpl[0][1].n > 0 && ctx->refine.tpl[1][1].n > 0);
+        CHECK_LT(err_half, 0.1);
+    }
+}
+
 void test_lines_subpixel(void)
 {
     home_context *ctx = context(NULL);
@@ -596,7 +628,7 @@ void test_refine_bad_inputs(void)
 }
 
 #define TEST_LIST(X) \
-    X(kernels_match_references) X(kernels_backends_identical) X(arena_and_config) X(textured_subpixel) X(point_budget) X(lines_subpixel) \
+    X(kernels_match_references) X(kernels_backends_identical) X(arena_and_config) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
     X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)

@@ -165,7 +165,7 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
     for (k = 0; k < n; k++) {
         int32_t raw = (int32_t)fz_u32(r);
         float f = fz_float_bits(r);
-        switch (fz_u8(r) % 19) {
+        switch (fz_u8(r) % 20) {
         case 0: cfg->theta_bins = raw % 4096; break;
         case 1: cfg->wrap_band = raw % 1024; break;
         case 2: cfg->r_step = f; break;
@@ -184,6 +184,7 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
         case 15: cfg->hough_downscale = raw % 6; break; /* 1, 2, 4 valid */
         case 16: cfg->match_theta_window = raw % 4096; break;
         case 17: cfg->refine_points = raw % 8192; break;
+        case 18: cfg->refine_finest_level = raw % 4; break;
         default: cfg->width = raw; break;
         }
     }
