@@ -59,6 +59,7 @@ typedef struct home__refine_points {
 typedef struct home__refine_state {
     int levels;                       /* 0: refinement off */
     int finest_level;                 /* the finest level points are selected at */
+    int base_level;                   /* the finest level with pixels (pyr[l] NULL below it) */
     int w[HOME_REFINE_MAX_LEVELS], h[HOME_REFINE_MAX_LEVELS];
     uint8_t *pyr[HOME_REFINE_MAX_LEVELS];
     uint32_t pyr_id, slot_id[2];

@@ -104,14 +104,20 @@ static size_t blocks_at(const home_config *cfg, int level)
     return ((w + b - 1) / b) * ((h + b - 1) / b);
 }
 
-/* Scratch: per-point floats at match time (two warps, residuals, weights), or at extraction
- * time a row of int16 for the blur and a row of selection keys, then the block cells. */
 static int finest_for(const home_config *cfg)
 {
     const int levels = levels_for(cfg);
     return cfg->refine_finest_level < levels ? cfg->refine_finest_level : levels - 1;
 }
 
+/* The finest pyramid level computed: 0, or 1 when the refinement ends above full size (level 1
+ * is then the blur of the 2x2-mean image, not the 2x2 mean of the blurred image: no full-size
+ * pass but one 2x2 mean). */
+static int base_for(const home_config *cfg) { return finest_for(cfg) > 0 ? 1 : 0; }
+
+/* Scratch: per-point floats at match time (two warps, residuals, weights), or at extraction
+ * time a row of int16 for the blur, then the half-size image (base level 1) or, later, the
+ * block cells. */
 static size_t scratch_bytes(const home_config *cfg)
 {
     size_t match = 4 * (size_t)level_capacity(cfg, finest_for(cfg)) * sizeof(float), sel = 0;
@@ -119,6 +125,10 @@ static size_t scratch_bytes(const home_config *cfg)
     for (l = finest_for(cfg); l < levels_for(cfg); l++) {
         size_t s = blocks_at(cfg, l) * sizeof(uint16_t);
         if (s > sel) sel = s;
+    }
+    if (base_for(cfg)) {
+        size_t half = (size_t)(cfg->width >> 1) * (size_t)(cfg->height >> 1);
+        if (half > sel) sel = half;
     }
     sel += align64((size_t)cfg->width * sizeof(int16_t));
     return match > sel ? match : sel;
@@ -128,7 +138,7 @@ size_t home__refine_bytes(const home_config *cfg)
 {
     size_t total = 0;
     int l, n = cfg->refine_levels ? levels_for(cfg) : 0;
-    for (l = 0; l < n; l++) {
+    for (l = n ? base_for(cfg) : 0; l < n; l++) {
         total += align64((size_t)(cfg->width >> l) * (size_t)(cfg->height >> l) + HOME__REFINE_IMAGE_SLACK);
         if (l >= finest_for(cfg)) /* no template below the finest level */
             total += 2 * 5 * align64((size_t)(level_capacity(cfg, l) + LANES) * sizeof(int16_t));
@@ -144,11 +154,13 @@ void home__refine_init(home_context *ctx, unsigned char *block)
     memset(st, 0, sizeof *st);
     st->levels = ctx->cfg.refine_levels ? levels_for(&ctx->cfg) : 0;
     st->finest_level = st->levels ? finest_for(&ctx->cfg) : 0;
+    st->base_level = st->levels ? base_for(&ctx->cfg) : 0;
     st->rk = home__refine_kernels_for(ctx->cfg.simd);
     if (!st->rk) st->rk = &home__refine_kernels_scalar; /* every backend gives the same result */
     for (l = 0; l < st->levels; l++) {
         st->w[l] = ctx->cfg.width >> l;
         st->h[l] = ctx->cfg.height >> l;
+        if (l < st->base_level) continue; /* never computed: no pixels */
         st->pyr[l] = block;
         block += align64((size_t)st->w[l] * (size_t)st->h[l] + HOME__REFINE_IMAGE_SLACK);
         for (s = 0; s < 2 && l >= st->finest_level; s++) {
@@ -279,8 +291,14 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     row_tmp = (int16_t *)st->scratch;
     cells = (uint16_t *)(void *)((unsigned char *)st->scratch +
                                  align64((size_t)st->w[0] * sizeof(int16_t)));
-    st->rk->blur3(image, stride, st->pyr[0], st->w[0], st->w[0], st->h[0], row_tmp);
-    for (l = 1; l < st->levels; l++)
+    if (st->base_level == 0) {
+        st->rk->blur3(image, stride, st->pyr[0], st->w[0], st->w[0], st->h[0], row_tmp);
+    } else {
+        uint8_t *half = (uint8_t *)cells; /* free until the selection below */
+        st->rk->downsample(image, stride, half, st->w[1], st->w[1], st->h[1]);
+        st->rk->blur3(half, st->w[1], st->pyr[1], st->w[1], st->w[1], st->h[1], row_tmp);
+    }
+    for (l = st->base_level + 1; l < st->levels; l++)
         st->rk->downsample(st->pyr[l - 1], st->w[l - 1], st->pyr[l], st->w[l], st->w[l], st->h[l]);
     /* the id is a hash of the data: the same frame gets the same id, so outputs stay
      * deterministic, and features are tied to the snapshot they were extracted with */
