@@ -101,9 +101,61 @@ static int extremum_candidates_avx2(const float *up, const float *mid, const flo
     return count;
 }
 
+/* Eight lines per step; every table lookup is a gather. Lines that never enter the image
+ * (entry >= after) are masked out of the shift and pixel gathers, so nothing past the rows is
+ * read. Pixels are gathered as 32-bit words and masked to their low byte. */
+static void line_ends_avx2(const uint8_t *base, ptrdiff_t stride, const int16_t *shift, int j0,
+                           const int16_t *entry, const int16_t *after, const int32_t *left,
+                           const int32_t *right, int32_t right_total, int i0, int i1,
+                           int32_t *sum, float *line)
+{
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), one = _mm256_set1_epi32(1);
+    const __m256i vstride = _mm256_set1_epi32((int32_t)stride), total = _mm256_set1_epi32(right_total);
+    const __m256i low_byte = _mm256_set1_epi32(0xff);
+    const int *shift_words = (const int *)(const void *)shift;
+    int i = i0;
+    for (; i + 8 <= i1; i += 8) {
+        const __m256i e = _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(entry + i)));
+        const __m256i a = _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(after + i)));
+        const __m256i inside = _mm256_cmpgt_epi32(a, e), zero = _mm256_setzero_si256();
+        const __m256i j = _mm256_add_epi32(_mm256_set1_epi32(j0 + i), lane), last = _mm256_sub_epi32(a, one);
+        __m256i border = _mm256_sub_epi32(_mm256_add_epi32(_mm256_i32gather_epi32(left, e, 4), total),
+                                          _mm256_i32gather_epi32(right, a, 4));
+        __m256i s_first = _mm256_mask_i32gather_epi32(zero, shift_words, e, inside, 2);
+        __m256i s_last = _mm256_mask_i32gather_epi32(zero, shift_words, last, inside, 2);
+        __m256i at_first, at_last, p_first, p_last;
+        __m256i *sum_at = (__m256i *)(void *)(sum + i);
+        s_first = _mm256_srai_epi32(_mm256_slli_epi32(s_first, 16), 16);
+        s_last = _mm256_srai_epi32(_mm256_slli_epi32(s_last, 16), 16);
+        at_first = _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(e, vstride), j), s_first);
+        at_last = _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(last, vstride), j), s_last);
+        p_first = _mm256_and_si256(_mm256_mask_i32gather_epi32(zero, (const int *)(const void *)base,
+                                                               at_first, inside, 1), low_byte);
+        p_last = _mm256_and_si256(_mm256_mask_i32gather_epi32(zero, (const int *)(const void *)base,
+                                                              at_last, inside, 1), low_byte);
+        _mm256_storeu_si256(sum_at, _mm256_add_epi32(_mm256_loadu_si256(sum_at), border));
+        _mm256_storeu_ps(line + i, _mm256_cvtepi32_ps(_mm256_sub_epi32(p_last, p_first)));
+    }
+    for (; i < i1; i++)
+        home__line_ends_px(base, stride, shift, j0, entry, after, left, right, right_total, i, sum,
+                           line);
+}
+
+static void resample_avx2(const float *line, const int16_t *k, const float *f, int n, float *out)
+{
+    int i = 0;
+    for (; i + 8 <= n; i += 8) {
+        const __m256i kk = _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(k + i)));
+        const __m256 lo = _mm256_i32gather_ps(line, kk, 4), hi = _mm256_i32gather_ps(line + 1, kk, 4);
+        _mm256_storeu_ps(out + i, _mm256_add_ps(lo, _mm256_mul_ps(_mm256_loadu_ps(f + i),
+                                                                  _mm256_sub_ps(hi, lo))));
+    }
+    for (; i < n; i++) out[i] = home__resample_px(line, k[i], f[i]);
+}
+
 const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
                                           smooth_row_avx2, smooth_cols_avx2, home__box_down_sse,
-                                          extremum_candidates_avx2,
+                                          extremum_candidates_avx2, line_ends_avx2, resample_avx2,
     &home__refine_kernels_avx2, &home__stab_kernels_avx2};
 #else
 typedef int home__avx2_unavailable; /* ISO C forbids an empty translation unit */

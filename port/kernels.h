@@ -46,12 +46,48 @@ typedef struct home__kernels {
      * them all, into idx; returns how many (comparisons only: exact in every backend). */
     int (*extremum_candidates)(const float *up, const float *mid, const float *down, int n,
                                int *idx);
+    /* The line-end terms of a theta row's lines that cross the image's side, i in [i0, i1)
+     * (src/hough.c's shear geometry: line j0 + i meets row p at column j0 + i + shift[p]):
+     *   sum[i] += left[entry[i]] + right_total - right[after[i]]
+     *   line[i] = entry[i] < after[i] ? P(after[i] - 1) - P(entry[i]) : 0,
+     *   P(p) = base[p * stride + j0 + i + shift[p]].
+     * shift may be read one int16 past row entries' range, base 3 bytes past a pixel. */
+    void (*line_ends)(const uint8_t *base, ptrdiff_t stride, const int16_t *shift, int j0,
+                      const int16_t *entry, const int16_t *after, const int32_t *left,
+                      const int32_t *right, int32_t right_total, int i0, int i1, int32_t *sum,
+                      float *line);
+    /* Linear resampling: out[i] = line[k[i]] + f[i] * (line[k[i] + 1] - line[k[i]]), i < n. */
+    void (*resample)(const float *line, const int16_t *k, const float *f, int n, float *out);
     /* the photometric refinement's and the stabiliser's kernels of the same backend */
     const struct home__refine_kernels *refine;
     const struct home__stab_kernels *stab;
 } home__kernels;
 
+/* The references of line_ends and resample at one index (scalar kernels and SIMD tails). */
+static inline void home__line_ends_px(const uint8_t *base, ptrdiff_t stride, const int16_t *shift,
+                                      int j0, const int16_t *entry, const int16_t *after,
+                                      const int32_t *left, const int32_t *right,
+                                      int32_t right_total, int i, int32_t *sum, float *line)
+{
+    const int e = entry[i], a = after[i], j = j0 + i;
+    sum[i] += left[e] + right_total - right[a];
+    line[i] = e < a ? (float)(base[(ptrdiff_t)(a - 1) * stride + j + shift[a - 1]] -
+                              base[(ptrdiff_t)e * stride + j + shift[e]]) /* exact: |.| <= 255 */
+                    : 0.0f;
+}
+
+static inline float home__resample_px(const float *line, int k, float f)
+{
+    return line[k] + f * (line[k + 1] - line[k]);
+}
+
 extern const home__kernels home__kernels_scalar;
+/* shared by the tables without gathers (SSE2, NEON) */
+void home__line_ends_scalar(const uint8_t *base, ptrdiff_t stride, const int16_t *shift, int j0,
+                            const int16_t *entry, const int16_t *after, const int32_t *left,
+                            const int32_t *right, int32_t right_total, int i0, int i1,
+                            int32_t *sum, float *line);
+void home__resample_scalar(const float *line, const int16_t *k, const float *f, int n, float *out);
 #if defined(__SSE2__)
 #define HOME__HAVE_SSE 1
 extern const home__kernels home__kernels_sse;

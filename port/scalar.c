@@ -75,7 +75,25 @@ static int extremum_candidates_scalar(const float *up, const float *mid, const f
     return count;
 }
 
+void home__line_ends_scalar(const uint8_t *base, ptrdiff_t stride, const int16_t *shift, int j0,
+                            const int16_t *entry, const int16_t *after, const int32_t *left,
+                            const int32_t *right, int32_t right_total, int i0, int i1,
+                            int32_t *sum, float *line)
+{
+    int i;
+    for (i = i0; i < i1; i++)
+        home__line_ends_px(base, stride, shift, j0, entry, after, left, right, right_total, i, sum,
+                           line);
+}
+
+void home__resample_scalar(const float *line, const int16_t *k, const float *f, int n, float *out)
+{
+    int i;
+    for (i = 0; i < n; i++) out[i] = home__resample_px(line, k[i], f[i]);
+}
+
 const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
                                             smooth_row_scalar, smooth_cols_scalar, box_down_scalar,
                                             extremum_candidates_scalar,
+                                            home__line_ends_scalar, home__resample_scalar,
     &home__refine_kernels_scalar, &home__stab_kernels_scalar};

@@ -197,7 +197,7 @@ static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
 
 static size_t geom_record_bytes(int longest, int blocks, size_t intercepts, size_t r_bins)
 {
-    return align16((size_t)longest * sizeof(int16_t)) + 2 * align16((size_t)blocks * sizeof(int16_t)) +
+    return align16(((size_t)longest + 1) * sizeof(int16_t)) + 2 * align16((size_t)blocks * sizeof(int16_t)) +
            align16(((size_t)longest + 4) * sizeof(int32_t)) + 2 * align16(intercepts * sizeof(int16_t)) +
            align16(r_bins * sizeof(int16_t)) + align16(r_bins * sizeof(float));
 }
@@ -206,8 +206,8 @@ static size_t geom_record_bytes(int longest, int blocks, size_t intercepts, size
 static void carve_geom(home__theta_geom *g, unsigned char *mem, int longest, int blocks,
                        size_t intercepts, size_t r_bins)
 {
-    g->shift = (int16_t *)(void *)mem;
-    mem += align16((size_t)longest * sizeof(int16_t));
+    g->shift = (int16_t *)(void *)mem; /* + 1: line_ends may read a word at the last row */
+    mem += align16(((size_t)longest + 1) * sizeof(int16_t));
     g->row_lo = (int16_t *)(void *)mem;
     mem += align16((size_t)blocks * sizeof(int16_t));
     g->row_hi = (int16_t *)(void *)mem;

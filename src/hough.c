@@ -221,36 +221,28 @@ static void fast_theta_row(home_context *ctx, const home__theta_geom *g, float *
     int32_t *sum = ctx->line_sum;
     float *line = ctx->line_j;
     ptrdiff_t stride;
-    int rows, cols, j, i;
+    int rows, cols, i;
     const uint8_t *base = family_image(ctx, g->vertical, g->flip, &stride, &rows, &cols);
 
     ctx->kernels->radon_blocks(base, stride, shift, j0, g->n_blocks, g->row_lo, g->row_hi, sum);
     {
-        const int32_t right_total = right[rows];
-        /* lines through every row (entry 0, exit rows - 1): no border term, and their end
-         * pixels lie on two contiguous rows */
-        const int mid_lo = -s_min - j0, mid_hi = cols - s_max - j0; /* [mid_lo, mid_hi) */
+        /* lines through every row (entry 0, exit rows - 1), [mid_lo, mid_hi): no border term,
+         * and their end pixels lie on two contiguous rows; the others cross a side of the
+         * image: the replicated border's share (the rows outside it) and their own ends */
+        const int mid_lo = -s_min - j0, mid_hi = cols - s_max - j0;
         const uint8_t *first_row_px = base + shift[0];
         const uint8_t *last_row_px = base + (ptrdiff_t)(rows - 1) * stride + shift[rows - 1];
-        for (i = 0; i < n; i++) {
-            int entry, after;
-            if (i == mid_lo && mid_lo < mid_hi) {
-                for (; i < mid_hi; i++)
-                    line[i] = (float)(last_row_px[j0 + i] - first_row_px[j0 + i]);
-                if (i >= n) break;
-            }
-            j = j0 + i;
-            entry = g->entry[i];
-            after = g->after[i];
-            /* the replicated border's share of the line: the rows outside the image */
-            sum[i] += left[entry] + right_total - right[after];
-            if (entry < after) {
-                int first_value = base[(ptrdiff_t)entry * stride + j + shift[entry]];
-                int last_value = base[(ptrdiff_t)(after - 1) * stride + j + shift[after - 1]];
-                line[i] = (float)(last_value - first_value); /* exact: |.| <= 255 */
-            } else {
-                line[i] = 0.0f;
-            }
+        const int32_t right_total = right[rows];
+        if (mid_lo < mid_hi) {
+            ctx->kernels->line_ends(base, stride, shift, j0, g->entry, g->after, left, right,
+                                    right_total, 0, mid_lo, sum, line);
+            for (i = mid_lo; i < mid_hi; i++)
+                line[i] = (float)(last_row_px[j0 + i] - first_row_px[j0 + i]);
+            ctx->kernels->line_ends(base, stride, shift, j0, g->entry, g->after, left, right,
+                                    right_total, mid_hi, n, sum, line);
+        } else {
+            ctx->kernels->line_ends(base, stride, shift, j0, g->entry, g->after, left, right,
+                                    right_total, 0, n, sum, line);
         }
     }
     /* J on the intercept grid (in place over the end terms), then resampled to the r axis */
@@ -262,14 +254,9 @@ static void fast_theta_row(home_context *ctx, const home__theta_geom *g, float *
     }
     {
         const int r_bins = ctx->r_bins, i_lo = g->i_lo, i_hi = g->i_hi;
-        const int16_t *rk = g->res_k - i_lo;
-        const float *rf = g->res_f - i_lo;
         for (i = 0; i < i_lo; i++) out[i] = 0.0f;
-        for (; i < i_hi; i++) {
-            const int k = rk[i];
-            out[i] = line[k] + rf[i] * (line[k + 1] - line[k]);
-        }
-        for (; i < r_bins; i++) out[i] = 0.0f;
+        ctx->kernels->resample(line, g->res_k, g->res_f, i_hi - i_lo, out + i_lo);
+        for (i = i_hi; i < r_bins; i++) out[i] = 0.0f;
     }
 }
 

@@ -55,6 +55,95 @@ void test_kernels_radon(void)
     CHECK(compared == 0 || compared >= 40);
 }
 
+/* The line-end terms: random entry/after rows (including lines that never enter: entry >=
+ * after, and entry == rows), a sheared geometry, negative strides, odd ranges. */
+void test_kernels_line_ends(void)
+{
+    enum { ROWS = 90, COLS = 61, PAD = HOME__RADON_BLOCK, STRIDE = COLS + 2 * PAD + 3, N = 150 };
+    static uint8_t image[ROWS * STRIDE + 64];
+    int16_t shift[ROWS + 1], entry[N], after[N];
+    int32_t left[ROWS + 1], right[ROWS + 1], want_sum[N], got_sum[N];
+    float want_line[N], got_line[N];
+    synth_rng rng;
+    size_t bi;
+    int trial, compared = 0;
+    synth_seed(&rng, 23);
+    for (trial = 0; trial < 30; trial++) {
+        const int flip = trial & 1, i0 = trial % 7, i1 = N - trial % 5, j0 = -ROWS / 2 - 1;
+        uint8_t *base = image + PAD + trial % 4;
+        const uint8_t *start = flip ? base + (ptrdiff_t)(ROWS - 1) * STRIDE : base;
+        const ptrdiff_t stride = flip ? -STRIDE : STRIDE;
+        int p, i;
+        for (p = 0; p < ROWS * STRIDE; p++) image[trial % 4 + p] = random_byte(&rng, trial % 5 == 0);
+        for (p = 0; p < ROWS; p++) shift[p] = (int16_t)(p / 2); /* 0 .. ROWS/2 - 1 */
+        shift[ROWS] = 0x7777; /* the word past the last row: must not matter */
+        for (p = 0; p <= ROWS; p++) {
+            left[p] = (int32_t)(synth_uniform(&rng) * 1e6);
+            right[p] = (int32_t)(synth_uniform(&rng) * 1e6);
+        }
+        for (i = 0; i < N; i++) {
+            /* a line j0 + i inside the columns on rows [entry, after) */
+            const int j = j0 + i;
+            int e = 0, a = ROWS;
+            while (e < ROWS && j + shift[e] < 0) e++;
+            a = e;
+            while (a < ROWS && j + shift[a] >= 0 && j + shift[a] < COLS) a++;
+            if (synth_uniform(&rng) < 0.1) { e = ROWS; a = ROWS; }      /* never enters */
+            else if (synth_uniform(&rng) < 0.1) { a = e; }             /* empty */
+            entry[i] = (int16_t)e;
+            after[i] = (int16_t)a;
+            want_sum[i] = (int32_t)(synth_uniform(&rng) * 1e6);
+        }
+        memcpy(got_sum, want_sum, sizeof got_sum);
+        for (i = 0; i < N; i++) want_line[i] = got_line[i] = -1.0f;
+        home__kernels_scalar.line_ends(start, stride, shift, j0, entry, after, left, right, 777,
+                                       i0, i1, want_sum, want_line);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *k = home__kernels_for(backends[bi]);
+            int32_t sum[N];
+            float line[N];
+            if (!k) continue;
+            memcpy(sum, got_sum, sizeof sum);
+            memcpy(line, got_line, sizeof line);
+            k->line_ends(start, stride, shift, j0, entry, after, left, right, 777, i0, i1, sum, line);
+            CHECK(memcmp(want_sum, sum, sizeof sum) == 0);
+            CHECK(memcmp(want_line, line, sizeof line) == 0);
+            compared++;
+        }
+    }
+    CHECK(compared == 0 || compared >= 30);
+}
+
+/* Resampling by gathered neighbours: random positions and weights, odd counts. */
+void test_kernels_resample(void)
+{
+    enum { N = 203 };
+    float line[N + 1], f[N], want[N], got[N];
+    int16_t k[N];
+    synth_rng rng;
+    size_t bi;
+    int trial, i, compared = 0;
+    synth_seed(&rng, 29);
+    for (trial = 0; trial < 10; trial++) {
+        const int n = N - trial * 3;
+        for (i = 0; i <= N; i++) line[i] = (float)(synth_uniform(&rng) * 2000.0 - 1000.0);
+        for (i = 0; i < N; i++) {
+            k[i] = (int16_t)(synth_uniform(&rng) * N);
+            f[i] = (float)synth_uniform(&rng);
+        }
+        home__kernels_scalar.resample(line, k, f, n, want);
+        for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
+            const home__kernels *kt = home__kernels_for(backends[bi]);
+            if (!kt) continue;
+            memset(got, 0, sizeof got);
+            kt->resample(line, k, f, n, got);
+            CHECK(memcmp(want, got, (size_t)n * sizeof *got) == 0);
+            compared++;
+        }
+    }
+    CHECK(compared == 0 || compared >= 10);
+}
+
 void test_kernels_nearest(void)
 {
     enum { N = 97, STRIDE = 48 };
