@@ -155,7 +155,7 @@ static void resample_avx2(const float *line, const int16_t *k, const float *f, i
 
 const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
                                           smooth_row_avx2, smooth_cols_avx2, home__box_down_sse,
-                                          extremum_candidates_avx2, line_ends_avx2, resample_avx2,
+                                          extremum_candidates_avx2, line_ends_avx2, resample_avx2, &home__line_fit_avx2,
     &home__refine_kernels_avx2, &home__stab_kernels_avx2};
 #else
 typedef int home__avx2_unavailable; /* ISO C forbids an empty translation unit */

@@ -15,6 +15,8 @@
 
 struct home__refine_kernels; /* port/refine_kernels.h */
 struct home__stab_kernels;   /* port/stab_kernels.h */
+struct home__line_fit;       /* src/home_internal.h */
+extern const struct home__line_fit home__line_fit_generic; /* src/homography.c */
 
 typedef struct home__kernels {
     const char *name;
@@ -58,6 +60,8 @@ typedef struct home__kernels {
                       float *line);
     /* Linear resampling: out[i] = line[k[i]] + f[i] * (line[k[i] + 1] - line[k[i]]), i < n. */
     void (*resample)(const float *line, const int16_t *k, const float *f, int n, float *out);
+    /* the homography's line fit (src/line_fit.h compiled for this instruction set) */
+    const struct home__line_fit *line_fit;
     /* the photometric refinement's and the stabiliser's kernels of the same backend */
     const struct home__refine_kernels *refine;
     const struct home__stab_kernels *stab;
@@ -118,6 +122,7 @@ static inline int home__is_extremum(const float *up, const float *mid, const flo
 /* port/avx2.c is compiled with -mavx2 and used only when the CPU reports AVX2 */
 #define HOME__HAVE_AVX2 1
 extern const home__kernels home__kernels_avx2;
+extern const struct home__line_fit home__line_fit_avx2; /* port/line_fit_avx2.c */
 #endif
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #define HOME__HAVE_NEON 1

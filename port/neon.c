@@ -142,7 +142,7 @@ static int extremum_candidates_neon(const float *up, const float *mid, const flo
 const home__kernels home__kernels_neon = {"neon", radon_blocks_neon, nearest2_l1_neon,
                                           smooth_row_neon, smooth_cols_neon, box_down_neon,
                                           extremum_candidates_neon,
-                                          home__line_ends_scalar, home__resample_scalar,
+                                          home__line_ends_scalar, home__resample_scalar, &home__line_fit_generic,
     &home__refine_kernels_neon, &home__stab_kernels_neon};
 #else
 typedef int home__neon_unavailable; /* ISO C forbids an empty translation unit */

@@ -95,5 +95,5 @@ void home__resample_scalar(const float *line, const int16_t *k, const float *f, 
 const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
                                             smooth_row_scalar, smooth_cols_scalar, box_down_scalar,
                                             extremum_candidates_scalar,
-                                            home__line_ends_scalar, home__resample_scalar,
+                                            home__line_ends_scalar, home__resample_scalar, &home__line_fit_generic,
     &home__refine_kernels_scalar, &home__stab_kernels_scalar};

@@ -152,7 +152,7 @@ int home__extremum_candidates_sse(const float *up, const float *mid, const float
 const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, home__nearest2_l1_sse,
                                          home__smooth_row_sse, home__smooth_cols_sse, home__box_down_sse,
                                          home__extremum_candidates_sse,
-                                         home__line_ends_scalar, home__resample_scalar,
+                                         home__line_ends_scalar, home__resample_scalar, &home__line_fit_generic,
     &home__refine_kernels_sse, &home__stab_kernels_sse};
 #else
 typedef int home__sse_unavailable; /* ISO C forbids an empty translation unit */

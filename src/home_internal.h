@@ -194,6 +194,23 @@ typedef double (*home__normal_fn)(const void *user, const double *p, double *jtj
 int home__lm_solve(double *p, home__normal_fn fn, const void *user, int max_iters);
 int home__solve_spd8(double *a, double *b);
 
+/* line_fit.h: the homography's line fit over matched lines, one implementation compiled per
+ * instruction set (the backend's table picks it); the same bits from each. */
+typedef struct home__line_problem {
+    const home__match *matches;
+    const int *index;        /* the inliers the fit runs over */
+    int n;
+    double scale, inv_scale; /* half diagonal, px: normalises r */
+    double w_theta, w_r;     /* residual weights into Hough bins */
+} home__line_problem;
+typedef struct home__line_fit {
+    /* cost, and J^T J, J^T e when jtj is not NULL, over the inliers (home__lm_solve's fn) */
+    home__normal_fn normal;
+    /* the matches (of n) whose transfer error at g is under threshold, into index; how many */
+    int (*select_inliers)(const home__line_problem *lp, int n, const double *g, double threshold,
+                          int *index);
+} home__line_fit;
+
 /* refine.c */
 void home__refine_defaults(home_config *cfg);
 int home__refine_validate(const home_config *cfg);
