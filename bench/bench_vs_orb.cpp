@@ -7,7 +7,7 @@
 //   ORB frame: ORB(2000).detectAndCompute on the new frame + BFMatcher knn ratio 0.75 against
 //     the previous frame's cached descriptors + findHomography(RANSAC).
 //   Head to head: the ORB frame and the HOME video frames (home_video_config, and the same
-//     with the refinement ending at half size; the automatic backend) timed in rotation, 5x
+//     with the refinement ending at full size; the automatic backend) timed in rotation, 5x
 //     runs of each, so load on a shared machine hits all alike.
 // Prints a table and the ratios; usage: home-bench [runs]
 #include <opencv2/calib3d.hpp>
@@ -47,16 +47,16 @@ struct HomeContext {
 };
 
 // preset 0: defaults with refinement; 1: defaults without; 2: home_video_config (Hough of a
-// ~160 px wide box-downscaled frame, 120 theta bins, theta window, refinement at full size);
-// 3: the video preset with the refinement ending at half size (refine_finest_level = 1)
-static const char *preset_name[] = {"default", "no-refine", "video", "video-half"};
+// ~160 px wide box-downscaled frame, 120 theta bins, theta window, refinement ending at half
+// size); 3: the video preset with the refinement ending at full size (refine_finest_level 0)
+static const char *preset_name[] = {"default", "no-refine", "video", "video-full"};
 enum { N_PRESETS = 4 };
 
 static void preset_config(int preset, int w, int h, home_config &cfg) {
     if (preset >= 2) home_video_config(&cfg, w, h);
     else home_default_config(&cfg, w, h);
     if (preset == 1) cfg.refine_levels = 0;
-    if (preset == 3) cfg.refine_finest_level = 1;
+    if (preset == 3) cfg.refine_finest_level = 0;
 }
 
 static bool time_home(int simd, int preset, int w, int h, const std::vector<uint8_t> &a,
@@ -169,8 +169,8 @@ static bool head_to_head(int w, int h, const std::vector<uint8_t> &a, const std:
 }
 
 // Only the per-frame work, n times, for instruction counting under callgrind:
-//   home-bench --frames orb|video|video-half|home N [downscale [theta_window [threshold_start [theta_bins [keypoints]]]]]
-// (video: home_video_config; video-half: the same, refinement ending at half size; home: the defaults with the given overrides)
+//   home-bench --frames orb|video|video-full|home N [downscale [theta_window [threshold_start [theta_bins [keypoints]]]]]
+// (video: home_video_config; video-full: the same, refinement ending at full size; home: the defaults with the given overrides)
 static int count_frames(const char *method, int n, int downscale, int window, float t0, int theta_bins,
                         int keypoints) {
     const int w = 640, h = 360;
@@ -187,7 +187,7 @@ static int count_frames(const char *method, int n, int downscale, int window, fl
         return 0;
     }
     home_config cfg;
-    if (std::string(method) == "video" || std::string(method) == "video-half") {
+    if (std::string(method) == "video" || std::string(method) == "video-full") {
         preset_config(std::string(method) == "video" ? 2 : 3, w, h, cfg);
         downscale = cfg.hough_downscale;
         window = cfg.match_theta_window;
@@ -263,7 +263,7 @@ int main(int argc, char **argv) {
         const char *backend = "";
         if (head_to_head(w, h, a, b, 5 * runs, h2h_orb, h2h_home, &backend))
             printf("head to head (in rotation, %d runs each, %s): ORB frame %.2f ms; HOME video frame "
-                   "%.2f ms, ORB/HOME %.2f; video-half frame %.2f ms, ORB/HOME %.2f\n",
+                   "%.2f ms, ORB/HOME %.2f; video-full frame %.2f ms, ORB/HOME %.2f\n",
                    5 * runs, backend, h2h_orb, h2h_home[0], h2h_orb / h2h_home[0], h2h_home[1],
                    h2h_orb / h2h_home[1]);
         printf("\n");

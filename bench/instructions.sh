@@ -18,8 +18,8 @@ orb=$(per_frame none orb x 1)
 printf '\n%-8s %-10s %14s %10s %14s\n' method preset frame_Ir "ORB/HOME" "A72 est. ms"
 printf '%-8s %-10s %14d %10s %14s\n' orb - "$orb" 1.00 -
 for simd in none sse avx2; do
-  for preset in default video; do
-    method=$([ $preset = default ] && echo home || echo video)
+  for preset in default video video-full; do
+    method=$([ $preset = default ] && echo home || echo $preset)
     n=$(HOME_SIMD=$simd valgrind --tool=callgrind --callgrind-out-file=/dev/null "$bench" --frames $method 1 2>&1 >/dev/null | awk '/Collected/ {print $NF}')
     m=$(HOME_SIMD=$simd valgrind --tool=callgrind --callgrind-out-file=/dev/null "$bench" --frames $method 3 2>&1 >/dev/null | awk '/Collected/ {print $NF}')
     [ -n "$n" ] && [ -n "$m" ] || continue

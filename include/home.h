@@ -111,8 +111,9 @@ int home_default_config(home_config *cfg, int width, int height);
 /* Defaults for consecutive video frames (small motion between them, registered against cached
  * features): the Hough transform of a box-downscaled frame about 160 px wide with 120 theta
  * bins, 500 keypoints per sign, an 8-bin (12 degree) theta window, a first threshold of 8;
- * the photometric refinement at full resolution (2048 template points) restores sub-pixel
- * precision. Motion between
+ * the photometric refinement (2048 template points, ending at half resolution:
+ * refine_finest_level 1; set it to 0 for full resolution at ~30 % more time) restores
+ * sub-pixel precision. Motion between
  * the frames should stay under ~30 px at the corners (README, Speed). */
 int home_video_config(home_config *cfg, int width, int height);
 

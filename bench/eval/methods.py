@@ -211,9 +211,7 @@ def registry(home_exe):
         methods["home-video-noref"] = HomeCli("HOME (video preset, no refinement)", home_exe,
                                               ["--video", "--no-refine"])
     if home_supports(home_exe, "--refine-finest"):
-        methods["home-video-half"] = HomeCli("HOME (video preset, refinement to half size)",
-                                             home_exe, ["--video", "--refine-finest", "1"])
-        methods["home-video-half4k"] = HomeCli("HOME (video, half size, 4096)",
-                                             home_exe, ["--video", "--refine-finest", "1", "--refine-points", "4096"])
+        methods["home-video-full"] = HomeCli("HOME (video preset, refinement to full size)",
+                                             home_exe, ["--video", "--refine-finest", "0"])
     methods["orb+ecc"] = EccRefined(orb)
     return methods
