@@ -186,6 +186,9 @@ int home__match_features(home_context *ctx, const home_features *a, const home_f
 
 /* homography.c */
 int home__estimate_homography(home_context *ctx, int n_matches, home_result *result);
+/* 1 when H (pixels, h22 = 1) maps the width x height frame plausibly: det > 0, every corner in
+ * front (w > 0), and onto a convex quadrilateral of the same turn that is not collapsed. */
+int home__homography_plausible(const double *h, int width, int height);
 
 /* lm.c: minimise a sum of squares over 8 parameters. The problem supplies its cost and, when
  * jtj is not NULL, the Gauss-Newton normal equations J^T J (8x8, row-major) and J^T e at p, so

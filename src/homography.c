@@ -45,6 +45,34 @@ static void set_identity(double *h)
     for (k = 0; k < 9; k++) h[k] = (k % 4 == 0) ? 1.0 : 0.0;
 }
 
+int home__homography_plausible(const double *h, int width, int height)
+{
+    /* the image corners in order (a positive turn at each for the identity) */
+    const double xs[4] = {0.0, width - 1.0, width - 1.0, 0.0};
+    const double ys[4] = {0.0, 0.0, height - 1.0, height - 1.0};
+    const double min_cross = 1e-6 * (width - 1.0) * (height - 1.0);
+    double u[4], v[4];
+    int k;
+    if (!(det3(h) > 0.0)) return 0;
+    for (k = 0; k < 4; k++) {
+        /* every image corner in front (w > 0): no real motion between frames folds part of the
+         * image through infinity */
+        const double w = h[6] * xs[k] + h[7] * ys[k] + h[8];
+        if (!(w > 0.0)) return 0;
+        u[k] = (h[0] * xs[k] + h[1] * ys[k] + h[2]) / w;
+        v[k] = (h[3] * xs[k] + h[4] * ys[k] + h[5]) / w;
+    }
+    /* a convex quadrilateral turning the same way, and not collapsed: each corner's cross
+     * product above a millionth of the image's (an orientation-preserving H can still map the
+     * frame to a sliver along a line, which is no registration) */
+    for (k = 0; k < 4; k++) {
+        const int a = (k + 3) % 4, c = (k + 1) % 4;
+        const double cross = (u[k] - u[a]) * (v[c] - v[k]) - (v[k] - v[a]) * (u[c] - u[k]);
+        if (!(cross > min_cross)) return 0;
+    }
+    return 1;
+}
+
 int home__estimate_homography(home_context *ctx, int n_matches, home_result *result)
 {
     const home_config *cfg = &ctx->cfg;
@@ -110,18 +138,9 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     for (k = 0; k < 9; k++)
         if (!isfinite(h[k])) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
     for (k = 0; k < 9; k++) result->H[k] = h[k];
-    if (!(det3(h) > 0.0)) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
-    {
-        /* plausibility: every image corner must stay in front (w > 0); a homography that folds
-         * part of the frame through infinity is never a real camera motion between frames */
-        const double xs[2] = {0.0, cfg->width - 1.0}, ys[2] = {0.0, cfg->height - 1.0};
-        int cx_i, cy_i;
-        for (cx_i = 0; cx_i < 2; cx_i++)
-            for (cy_i = 0; cy_i < 2; cy_i++)
-                if (!(h[6] * xs[cx_i] + h[7] * ys[cy_i] + h[8] > 0.0)) {
-                    result->failure = HOME_FAIL_DEGENERATE;
-                    return HOME_OK;
-                }
+    if (!home__homography_plausible(h, cfg->width, cfg->height)) {
+        result->failure = HOME_FAIL_DEGENERATE;
+        return HOME_OK;
     }
     /* a downscaled Hough image's 1-bin gate spans several image px and spurious consistent
      * lines pass it more easily (one moved edge, which fixes 2 of 8 degrees of freedom, gave

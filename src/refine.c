@@ -698,6 +698,13 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return;
     }
+    /* the same plausibility HOME's estimate passed: a refinement that slid towards a singular
+     * H (a frame squeezed to a line keeps the photometric error low on flat content) is no
+     * estimate (fuzz_api found one: tests/fuzz/corpus/api/regress-refined-singular-h) */
+    if (!home__homography_plausible(h1, ctx->cfg.width, ctx->cfg.height)) {
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return;
+    }
     /* HOME's own precision scales with the Hough image's pixel: so does the trust region */
     if (max_corner_distance(&s, h1, h0) > ctx->cfg.refine_trust_px * ctx->hough_scale) {
         result->refine_status = HOME_REFINE_OUTSIDE_TRUST;

@@ -288,6 +288,31 @@ static int exact_matches(home_context *ctx, const double *h, int n, double outli
     return n;
 }
 
+/* The plausibility rule for an estimate (both HOME's and the refined one): real motions pass;
+ * a flip, a corner behind the camera and a frame squeezed to a line do not. The last
+ * is the H the refinement once returned for a fuzzed pair (det -3.5e-18). */
+void test_homography_plausible(void)
+{
+    const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const double zoom_out[9] = {0.05, 0, 300, 0, 0.05, 170, 0, 0, 1};
+    const double keystone[9] = {1.02, 0.03, -9, -0.02, 0.98, 6, 2e-4, -1e-4, 1};
+    const double mirror[9] = {-1, 0, 639, 0, 1, 0, 0, 0, 1};
+    const double behind[9] = {1, 0, 0, 0, 1, 0, -0.002, 0, 1};          /* w < 0 at x = 639 */
+    const double steep[9] = {1, 0, 0, 0, 1, 0, -0.0015, 0, 1};          /* w = 0.04 at x = 639 */
+    const double sliver[9] = {0.15883520771283627, 0.21936185211168963, 50.458401863441843,
+                              0.16610942426617356, 0.21939325425703907, 53.361697432041595,
+                              0.0031478445976687911, 0.0043473800994601412, 1};
+    const double thin[9] = {1, 0, 0, 0, 1e-7, 180, 0, 0, 1};            /* 360 px -> 4e-5 px */
+    CHECK(home__homography_plausible(identity, 640, 360));
+    CHECK(home__homography_plausible(zoom_out, 640, 360));
+    CHECK(home__homography_plausible(keystone, 640, 360));
+    CHECK(!home__homography_plausible(mirror, 640, 360));
+    CHECK(!home__homography_plausible(behind, 640, 360));
+    CHECK(home__homography_plausible(steep, 640, 360)); /* extreme, but in front and convex */
+    CHECK(!home__homography_plausible(sliver, 94, 87));
+    CHECK(!home__homography_plausible(thin, 640, 360));
+}
+
 void test_lm_exact_lines(void)
 {
     home_context *ctx = test_context(IMG_W, IMG_H, NULL);
