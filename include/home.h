@@ -176,7 +176,8 @@ enum home_failure {
     HOME_FAIL_FEW_INLIERS,    /* fewer than min_inliers (2x with hough_downscale > 1) at the
                                  final threshold */
     HOME_FAIL_DEGENERATE      /* det(H / H22) <= 0, an image corner mapped behind the camera
-                                 (w <= 0), or a numerically unusable estimate */
+                                 (w <= 0), the frame mapped to a non-convex, flipped or
+                                 collapsed quadrilateral, or a numerically unusable estimate */
 };
 
 /* What the photometric refinement did (result.refine_status). */
@@ -189,7 +190,8 @@ enum home_refine_status {
     HOME_REFINE_FEW_POINTS,       /* too little texture: fewer than 64 usable template points */
     HOME_REFINE_NOT_CONVERGED,    /* the finest level used hit refine_iterations */
     HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above 0.5 px (predicted, or from
-                                     two interleaved halves of the points) */
+                                     two interleaved halves of the points), or the refined H
+                                     fails HOME_FAIL_DEGENERATE's plausibility rule */
     HOME_REFINE_OUTSIDE_TRUST,    /* a corner left the trust region (refine_trust_px) */
     HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
     HOME_REFINE_LOW_CORRELATION   /* HOME failed and the refinement cannot vouch (rule below) */

@@ -153,8 +153,47 @@ static void resample_avx2(const float *line, const int16_t *k, const float *f, i
     for (; i < n; i++) out[i] = home__resample_px(line, k[i], f[i]);
 }
 
+/* Box downscale, 16 outputs per step: pmaddubsw adds horizontal pixel pairs of each source row,
+ * the rows are added, and for ds = 4 pmaddwd adds pairs of pairs; the SSE2 kernel takes the
+ * outputs left over. */
+static void box_down_avx2(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
+{
+    const __m256i ones8 = _mm256_set1_epi8(1), ones16 = _mm256_set1_epi16(1);
+    int x = 0, v;
+    if (ds == 4) {
+        const __m256i half = _mm256_set1_epi32(8);
+        for (; x + 16 <= out_w; x += 16) {
+            const uint8_t *s0 = src + 4 * x;
+            __m256i lo = _mm256_setzero_si256(), hi = lo;
+            for (v = 0; v < 4; v++) {
+                const uint8_t *row = s0 + (ptrdiff_t)v * stride;
+                lo = _mm256_add_epi16(lo, _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)row), ones8));
+                hi = _mm256_add_epi16(hi, _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(row + 32)), ones8));
+            }
+            lo = _mm256_srai_epi32(_mm256_add_epi32(_mm256_madd_epi16(lo, ones16), half), 4);
+            hi = _mm256_srai_epi32(_mm256_add_epi32(_mm256_madd_epi16(hi, ones16), half), 4);
+            /* packs per 128-bit lane: lo0 hi0 lo1 hi1 in order 0 2 1 3 after the pack */
+            lo = _mm256_permute4x64_epi64(_mm256_packs_epi32(lo, hi), 0xD8);
+            _mm_storeu_si128((__m128i *)(void *)(out + x),
+                             _mm256_castsi256_si128(_mm256_permute4x64_epi64(_mm256_packus_epi16(lo, lo), 0xD8)));
+        }
+    } else {
+        const __m256i half = _mm256_set1_epi16(2);
+        for (; x + 16 <= out_w; x += 16) {
+            const uint8_t *s0 = src + 2 * x;
+            __m256i sum = _mm256_add_epi16(
+                _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)s0), ones8),
+                _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(s0 + stride)), ones8));
+            sum = _mm256_srai_epi16(_mm256_add_epi16(sum, half), 2);
+            _mm_storeu_si128((__m128i *)(void *)(out + x),
+                             _mm256_castsi256_si128(_mm256_permute4x64_epi64(_mm256_packus_epi16(sum, sum), 0xD8)));
+        }
+    }
+    if (x < out_w) home__box_down_sse(src + ds * x, stride, ds, out + x, out_w - x);
+}
+
 const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
-                                          smooth_row_avx2, smooth_cols_avx2, home__box_down_sse,
+                                          smooth_row_avx2, smooth_cols_avx2, box_down_avx2,
                                           extremum_candidates_avx2, line_ends_avx2, resample_avx2, &home__line_fit_avx2,
     &home__refine_kernels_avx2, &home__stab_kernels_avx2};
 #else

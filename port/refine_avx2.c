@@ -1,6 +1,6 @@
 /* AVX2 kernels of the refinement (compiled with -mavx2, used when the CPU reports AVX2): the
- * 3x3 blur and the selection keys, which touch every pixel of every frame's snapshot, sixteen
- * pixels per step, and the warp (gathers); the rest of the table is the SSE2 one. Bit-identical to
+ * 3x3 blur, the 2x2 means and the selection keys, which touch every pixel of every frame's
+ * snapshot, sixteen pixels per step, and the warp (gathers); the rest of the table is the SSE2 one. Bit-identical to
  * port/refine_scalar.c (integer arithmetic only). */
 #include "kernels.h"
 #include "refine_kernels.h"
@@ -118,8 +118,33 @@ static void warp_avx2(const float *m, const int16_t *xs, const int16_t *ys, int 
     if (i < n) home__refine_warp_sse(m, xs + i, ys + i, n - i, img, stride, w, h, out + i);
 }
 
+/* 2x2 means, sixteen outputs per step (as the SSE2 kernel, twice as wide); the SSE2 kernel takes
+ * the columns left over */
+static void downsample_avx2(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
+                            ptrdiff_t dst_stride, int dst_w, int dst_h)
+{
+    const __m256i lo = _mm256_set1_epi16(0xff), two = _mm256_set1_epi16(2);
+    const int wide = dst_w & ~15;
+    int x, y;
+    for (y = 0; y < dst_h; y++) {
+        const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
+        uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
+        for (x = 0; x < wide; x += 16) {
+            __m256i va = _mm256_loadu_si256((const __m256i *)(const void *)(a + 2 * x));
+            __m256i vb = _mm256_loadu_si256((const __m256i *)(const void *)(b + 2 * x));
+            __m256i sum = _mm256_add_epi16(
+                _mm256_add_epi16(_mm256_and_si256(va, lo), _mm256_srli_epi16(va, 8)),
+                _mm256_add_epi16(_mm256_and_si256(vb, lo), _mm256_srli_epi16(vb, 8)));
+            store16_u8(d + x, _mm256_srli_epi16(_mm256_add_epi16(sum, two), 2));
+        }
+    }
+    if (wide < dst_w)
+        home__refine_downsample_sse(src + 2 * wide, src_stride, dst + wide, dst_stride,
+                                    dst_w - wide, dst_h);
+}
+
 const home__refine_kernels home__refine_kernels_avx2 = {
-    "avx2", blur3_avx2, home__refine_downsample_sse, select_keys_avx2, home__refine_block_max_sse,
+    "avx2", blur3_avx2, downsample_avx2, select_keys_avx2, home__refine_block_max_sse,
     warp_avx2,
     home__refine_accumulate_sse, home__refine_cauchy_sums_sse, home__refine_residuals_sse};
 #else
