@@ -46,9 +46,27 @@ static void radon_blocks_avx2(const uint8_t *base, ptrdiff_t stride, const int16
 
 /* Same multiply-then-add order as the scalar reference (no FMA), 8 outputs at a time:
  * bit-identical; the tails go to the SSE2 kernels. */
+/* The taps in the reference's order (k = 0 .. 2 radius), one product and one sum each. With the
+ * default radius 4 (sigma 1.3) the nine broadcast taps stay in registers, unrolled; other radii
+ * take the generic loop. */
+#define SMOOTH_TAP(k, src) acc = _mm256_add_ps(acc, _mm256_mul_ps(t##k, _mm256_loadu_ps(src)))
+
 static void smooth_row_avx2(const float *in, float *out, int n, const float *taps, int radius)
 {
     int i = radius, k;
+    if (radius == 4) {
+        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]), t2 = _mm256_set1_ps(taps[2]),
+                     t3 = _mm256_set1_ps(taps[3]), t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
+                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]), t8 = _mm256_set1_ps(taps[8]);
+        for (; i + 8 <= n - radius; i += 8) {
+            const float *p = in + i - 4;
+            __m256 acc = _mm256_setzero_ps();
+            SMOOTH_TAP(0, p); SMOOTH_TAP(1, p + 1); SMOOTH_TAP(2, p + 2); SMOOTH_TAP(3, p + 3);
+            SMOOTH_TAP(4, p + 4); SMOOTH_TAP(5, p + 5); SMOOTH_TAP(6, p + 6); SMOOTH_TAP(7, p + 7);
+            SMOOTH_TAP(8, p + 8);
+            _mm256_storeu_ps(out + i, acc);
+        }
+    }
     for (; i + 8 <= n - radius; i += 8) {
         __m256 acc = _mm256_setzero_ps();
         for (k = 0; k <= 2 * radius; k++)
@@ -62,6 +80,20 @@ static void smooth_cols_avx2(const float *const *rows, float *out, int n, const 
                              int radius)
 {
     int i = 0, k;
+    if (radius == 4) {
+        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]), t2 = _mm256_set1_ps(taps[2]),
+                     t3 = _mm256_set1_ps(taps[3]), t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
+                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]), t8 = _mm256_set1_ps(taps[8]);
+        const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4],
+                    *r5 = rows[5], *r6 = rows[6], *r7 = rows[7], *r8 = rows[8];
+        for (; i + 8 <= n; i += 8) {
+            __m256 acc = _mm256_setzero_ps();
+            SMOOTH_TAP(0, r0 + i); SMOOTH_TAP(1, r1 + i); SMOOTH_TAP(2, r2 + i); SMOOTH_TAP(3, r3 + i);
+            SMOOTH_TAP(4, r4 + i); SMOOTH_TAP(5, r5 + i); SMOOTH_TAP(6, r6 + i); SMOOTH_TAP(7, r7 + i);
+            SMOOTH_TAP(8, r8 + i);
+            _mm256_storeu_ps(out + i, acc);
+        }
+    }
     for (; i + 8 <= n; i += 8) {
         __m256 acc = _mm256_setzero_ps();
         for (k = 0; k <= 2 * radius; k++)
@@ -74,6 +106,7 @@ static void smooth_cols_avx2(const float *const *rows, float *out, int n, const 
         home__smooth_cols_sse(tail, out + i, n - i, taps, radius);
     }
 }
+#undef SMOOTH_TAP
 
 /* The SSE2 kernel's test on eight bins per step. */
 static int extremum_candidates_avx2(const float *up, const float *mid, const float *down, int n,
