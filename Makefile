@@ -44,13 +44,14 @@ $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_inte
 	$(CC) $(CFLAGS_LIB) -c $< -o $@
 
 # The Hough transform's per-theta loops (J from the line sums, the lines' end pixels), the
-# refinement's residual bins and the descriptors' radial profiles are plain element-wise loops
+# refinement's residual bins, the descriptors' radial profiles and J's statistics (four lanes)
+# are plain element-wise loops
 # that -O2's cheapest vectoriser leaves scalar (0.4, 0.2 and 0.2 M instructions per video
 # frame). Element-wise IEEE operations in C99
 # mode (no contraction, no reassociation), so bit-identical output.
 # The line fit (src/homography.c) works on four matches per step in separate lanes, element-wise
 # too; its sqrt vectorises only without errno (-fno-math-errno: same IEEE square roots).
-$(BUILD)/obj/src/hough.o $(BUILD)/obj/src/refine.o $(BUILD)/obj/src/describe.o: CFLAGS_LIB += -ftree-vectorize
+$(BUILD)/obj/src/hough.o $(BUILD)/obj/src/refine.o $(BUILD)/obj/src/describe.o $(BUILD)/obj/src/pipeline.o: CFLAGS_LIB += -ftree-vectorize
 # port/line_fit_avx2.c is the same fit compiled with AVX2 (four lanes, one 256-bit operation).
 $(BUILD)/obj/src/homography.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno
 $(BUILD)/obj/port/line_fit_avx2.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno $(AVX2_FLAGS)
