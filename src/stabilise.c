@@ -102,7 +102,7 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
      * 0.003 dB, also with 10 px / 1 degree shake; 15.7 -> 13.0 M instructions per 640x360
      * frame (2048: 13.9 M; 512: textureless jitter +0.007 px) */
     h->refine_points = STAB_REFINE_POINTS;
-    h->refine_finest_level = 0; /* the frame is already downscaled: refine at its full size */
+    h->refine_finest_level = 0; /* full size: what bench/stab measured (half size is not) */
     if (cfg->hough_downscale) h->hough_downscale = cfg->hough_downscale;
     h->simd = cfg->simd;
     /* 88 instead of the video defaults' 160 theta bins: the refinement gives the precision (on
