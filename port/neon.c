@@ -53,9 +53,29 @@ static void nearest2_l1_neon(const uint8_t *query, const uint8_t *cands, ptrdiff
 }
 
 /* vmulq then vaddq (never a fused multiply-add): the same rounding as the scalar reference. */
+/* The taps in the reference's order, one product and one sum each (no fused multiply-add); the
+ * default radius 4 (sigma 1.3) unrolled with its nine taps in registers, other radii by the
+ * generic loop. */
+#define SMOOTH_TAP(k, src) acc = vaddq_f32(acc, vmulq_f32(t##k, vld1q_f32(src)))
+#define SMOOTH_TAPS_4 \
+    const float32x4_t t0 = vdupq_n_f32(taps[0]), t1 = vdupq_n_f32(taps[1]), t2 = vdupq_n_f32(taps[2]), \
+                      t3 = vdupq_n_f32(taps[3]), t4 = vdupq_n_f32(taps[4]), t5 = vdupq_n_f32(taps[5]), \
+                      t6 = vdupq_n_f32(taps[6]), t7 = vdupq_n_f32(taps[7]), t8 = vdupq_n_f32(taps[8])
+
 static void smooth_row_neon(const float *in, float *out, int n, const float *taps, int radius)
 {
     int i = radius, k;
+    if (radius == 4) {
+        SMOOTH_TAPS_4;
+        for (; i + 4 <= n - radius; i += 4) {
+            const float *p = in + i - 4;
+            float32x4_t acc = vdupq_n_f32(0.0f);
+            SMOOTH_TAP(0, p); SMOOTH_TAP(1, p + 1); SMOOTH_TAP(2, p + 2); SMOOTH_TAP(3, p + 3);
+            SMOOTH_TAP(4, p + 4); SMOOTH_TAP(5, p + 5); SMOOTH_TAP(6, p + 6); SMOOTH_TAP(7, p + 7);
+            SMOOTH_TAP(8, p + 8);
+            vst1q_f32(out + i, acc);
+        }
+    }
     for (; i + 4 <= n - radius; i += 4) {
         float32x4_t acc = vdupq_n_f32(0.0f);
         for (k = 0; k <= 2 * radius; k++)
@@ -70,6 +90,18 @@ static void smooth_cols_neon(const float *const *rows, float *out, int n, const 
                              int radius)
 {
     int i = 0, k;
+    if (radius == 4) {
+        SMOOTH_TAPS_4;
+        const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4],
+                    *r5 = rows[5], *r6 = rows[6], *r7 = rows[7], *r8 = rows[8];
+        for (; i + 4 <= n; i += 4) {
+            float32x4_t acc = vdupq_n_f32(0.0f);
+            SMOOTH_TAP(0, r0 + i); SMOOTH_TAP(1, r1 + i); SMOOTH_TAP(2, r2 + i); SMOOTH_TAP(3, r3 + i);
+            SMOOTH_TAP(4, r4 + i); SMOOTH_TAP(5, r5 + i); SMOOTH_TAP(6, r6 + i); SMOOTH_TAP(7, r7 + i);
+            SMOOTH_TAP(8, r8 + i);
+            vst1q_f32(out + i, acc);
+        }
+    }
     for (; i + 4 <= n; i += 4) {
         float32x4_t acc = vdupq_n_f32(0.0f);
         for (k = 0; k <= 2 * radius; k++)
@@ -82,6 +114,8 @@ static void smooth_cols_neon(const float *const *rows, float *out, int n, const 
         home__kernels_scalar.smooth_cols(tail, out + i, n - i, taps, radius);
     }
 }
+#undef SMOOTH_TAP
+#undef SMOOTH_TAPS_4
 
 /* 8 outputs per step: pairwise widening adds along the row, accumulated over the rows, then a
  * rounding narrowing shift ((sum + half) >> shift); the tail by the reference. */

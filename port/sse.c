@@ -54,9 +54,28 @@ void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t
 }
 
 /* Same multiply-then-add order as the scalar reference, 4 outputs at a time: bit-identical. */
+/* The taps in the reference's order, one product and one sum each; the default radius 4 (sigma
+ * 1.3) unrolled with its nine broadcast taps in registers, other radii by the generic loop. */
+#define SMOOTH_TAP(k, src) acc = _mm_add_ps(acc, _mm_mul_ps(t##k, _mm_loadu_ps(src)))
+#define SMOOTH_TAPS_4 \
+    const __m128 t0 = _mm_set1_ps(taps[0]), t1 = _mm_set1_ps(taps[1]), t2 = _mm_set1_ps(taps[2]), \
+                 t3 = _mm_set1_ps(taps[3]), t4 = _mm_set1_ps(taps[4]), t5 = _mm_set1_ps(taps[5]), \
+                 t6 = _mm_set1_ps(taps[6]), t7 = _mm_set1_ps(taps[7]), t8 = _mm_set1_ps(taps[8])
+
 void home__smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius)
 {
     int i = radius, k;
+    if (radius == 4) {
+        SMOOTH_TAPS_4;
+        for (; i + 4 <= n - radius; i += 4) {
+            const float *p = in + i - 4;
+            __m128 acc = _mm_setzero_ps();
+            SMOOTH_TAP(0, p); SMOOTH_TAP(1, p + 1); SMOOTH_TAP(2, p + 2); SMOOTH_TAP(3, p + 3);
+            SMOOTH_TAP(4, p + 4); SMOOTH_TAP(5, p + 5); SMOOTH_TAP(6, p + 6); SMOOTH_TAP(7, p + 7);
+            SMOOTH_TAP(8, p + 8);
+            _mm_storeu_ps(out + i, acc);
+        }
+    }
     for (; i + 4 <= n - radius; i += 4) {
         __m128 acc = _mm_setzero_ps();
         for (k = 0; k <= 2 * radius; k++)
@@ -68,9 +87,21 @@ void home__smooth_row_sse(const float *in, float *out, int n, const float *taps,
 }
 
 void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
-                            int radius)
+                           int radius)
 {
     int i = 0, k;
+    if (radius == 4) {
+        SMOOTH_TAPS_4;
+        const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4],
+                    *r5 = rows[5], *r6 = rows[6], *r7 = rows[7], *r8 = rows[8];
+        for (; i + 4 <= n; i += 4) {
+            __m128 acc = _mm_setzero_ps();
+            SMOOTH_TAP(0, r0 + i); SMOOTH_TAP(1, r1 + i); SMOOTH_TAP(2, r2 + i); SMOOTH_TAP(3, r3 + i);
+            SMOOTH_TAP(4, r4 + i); SMOOTH_TAP(5, r5 + i); SMOOTH_TAP(6, r6 + i); SMOOTH_TAP(7, r7 + i);
+            SMOOTH_TAP(8, r8 + i);
+            _mm_storeu_ps(out + i, acc);
+        }
+    }
     for (; i + 4 <= n; i += 4) {
         __m128 acc = _mm_setzero_ps();
         for (k = 0; k <= 2 * radius; k++)
@@ -83,6 +114,8 @@ void home__smooth_cols_sse(const float *const *rows, float *out, int n, const fl
         home__kernels_scalar.smooth_cols(tail, out + i, n - i, taps, radius);
     }
 }
+#undef SMOOTH_TAP
+#undef SMOOTH_TAPS_4
 
 /* 16 outputs per step: rows summed in 16-bit lanes, neighbours paired by pmaddwd with ones (twice
  * for ds = 4), rounded and packed back to bytes; the tail by the reference. */
