@@ -32,6 +32,7 @@ static void usage(FILE *f)
             "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 960 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
+            "  --refine-finest L end the refinement at full (0) or half (1) size (default 0)\n"
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
             "                    its 1/2 or 1/4 size copy (2, 4; default: the one about 160 px wide)\n"
             "  --theta-bins N    HOME's theta bins (16..%d; default 88)\n"
@@ -125,7 +126,7 @@ int main(int argc, char **argv)
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
     home_stab_config cfg;
     double margin = 0.10, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0,
-           theta_bins = 0, ease = -1;
+           theta_bins = 0, ease = -1, refine_finest = -1;
     double t_start, ms_reg = 0, ms_warp = 0, last_report;
     app ap;
     home_stab *stab = NULL;
@@ -158,6 +159,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--smoothing")) { target = &smoothing; lo = 1; hi = 1000; }
         else if (!strcmp(a, "--lookahead")) { target = &lookahead; lo = 0; hi = HOME_STAB_MAX_LOOKAHEAD; }
         else if (!strcmp(a, "--ease")) { target = &ease; lo = 0; hi = 1; }
+        else if (!strcmp(a, "--refine-finest")) { target = &refine_finest; lo = 0; hi = 1; }
         else if (!strcmp(a, "--downscale")) { target = &downscale; lo = 1; hi = 4; }
         else if (!strcmp(a, "--hough-downscale")) { target = &hough_ds; lo = 1; hi = 4; }
         else if (!strcmp(a, "--theta-bins")) { target = &theta_bins; lo = 16; hi = HOME_MAX_THETA_BINS; }
@@ -183,6 +185,7 @@ int main(int argc, char **argv)
     if (downscale > 0) cfg.downscale = (int)downscale;
     cfg.keypoints_per_sign = (int)keypoints;
     cfg.refine = refine;
+    if (refine_finest >= 0) cfg.refine_finest_level = (int)refine_finest;
     if (hough_ds > 0) cfg.hough_downscale = (int)hough_ds;
     cfg.theta_bins = (int)theta_bins;
     cfg.clock = now_ms;

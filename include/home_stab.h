@@ -71,6 +71,9 @@ typedef struct home_stab_config {
     int min_inliers;          /* HOME's failure rule (see home_config) */
     int refine;               /* 1: HOME's photometric refinement of each H (home_config's
                                  refine_levels default), 0: off */
+    int refine_finest_level;  /* HOME's refine_finest_level (see home_config): 0 = the
+                                 refinement ends at the registration image's full size, 1 = at
+                                 half size (fewer instructions per frame, see bench/stab) */
     int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
                                  2x2- or 4x4-box downscaled copy (2, 4), see home_config; 0 =
                                  automatic (home_video_config's: a copy about 160 px wide) */

@@ -102,7 +102,7 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
      * 0.003 dB, also with 10 px / 1 degree shake; 15.7 -> 13.0 M instructions per 640x360
      * frame (2048: 13.9 M; 512: textureless jitter +0.007 px) */
     h->refine_points = STAB_REFINE_POINTS;
-    h->refine_finest_level = 0; /* full size: what bench/stab measured (half size is not) */
+    h->refine_finest_level = cfg->refine ? cfg->refine_finest_level : 0;
     if (cfg->hough_downscale) h->hough_downscale = cfg->hough_downscale;
     h->simd = cfg->simd;
     /* 88 instead of the video defaults' 160 theta bins: the refinement gives the precision (on
@@ -133,6 +133,7 @@ int home_stab_validate_config(const home_stab_config *cfg)
         !(cfg->smoothing == 0.0f || is_finite_in(cfg->smoothing, 1.0, 1000.0)) ||
         cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD || !is_finite_in(cfg->ease, 0.0, 1.0) ||
         (cfg->refine != 0 && cfg->refine != 1) ||
+        (cfg->refine_finest_level != 0 && cfg->refine_finest_level != 1) ||
         !is_finite_in(cfg->max_shift, 0.0, 1.0) || !is_finite_in(cfg->max_rotation, 0.0, 1.6) ||
         !is_finite_in(cfg->max_zoom, 0.0, 1.0) || !is_finite_in(cfg->max_residual, 0.0, 1e6))
         return HOME_E_CONFIG;

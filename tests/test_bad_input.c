@@ -236,6 +236,7 @@ static int y4m(const char *text, size_t size, int frames)
     X(stab_odd_width, HOME_E_SIZE, (sbad.width = W + 1, home_stab_validate_config(&sbad))) \
     X(stab_margin_nan, HOME_E_CONFIG, (sbad.margin = (float)NAN, home_stab_validate_config(&sbad))) \
     X(stab_theta_bins_below_16, HOME_E_CONFIG, (sbad.theta_bins = 15, home_stab_validate_config(&sbad))) \
+    X(stab_refine_finest_level_2, HOME_E_CONFIG, (sbad.refine_finest_level = 2, home_stab_validate_config(&sbad))) \
     X(stab_lookahead_above_max, HOME_E_CONFIG, (sbad.lookahead = HOME_STAB_MAX_LOOKAHEAD + 1, home_stab_validate_config(&sbad))) \
     X(stab_arena_one_byte_short, HOME_E_ARENA_SMALL, home_stab_init(&stab, &scfg, ALIGNED_ARENA(stab_arena.bytes), home_stab_arena_size(&scfg) - 1, NULL)) \
     X(stab_push_null_frame, HOME_E_NULL, home_stab_push(stab, NULL, &sout)) \

@@ -23,11 +23,15 @@ static union { unsigned char bytes[8u << 20]; double align; } arena;
 static uint8_t clip[CLIP_FRAMES][CW * CH * 3 / 2];
 static double clip_g[CLIP_FRAMES][9];
 
+/* refine_finest_level of the stabilisers make_stab() builds (one test sets it to 1) */
+static int stab_refine_finest;
+
 static home_stab *make_stab(int lookahead, int downscale, int theta_bins)
 {
     home_stab_config cfg;
     home_stab *st = NULL;
     home_stab_default_config(&cfg, CW, CH);
+    cfg.refine_finest_level = stab_refine_finest;
     cfg.lookahead = lookahead;
     cfg.downscale = downscale;
     cfg.theta_bins = theta_bins;
@@ -178,6 +182,25 @@ static void test_lookahead_latency_and_gain(void)
     CHECK_EQ_INT(ahead.emitted, CLIP_FRAMES);
     CHECK(ahead.inside);
     CHECK_LT(j1, j0);
+}
+
+/* The refinement ending at half size (fewer instructions per frame) keeps most of the full-size
+ * ending's precision, with the same latency and the window inside the frame. */
+static void test_refine_ending_at_half_size(void)
+{
+    static run_result full, half;
+    double j_full, j_half;
+    run_clip(12, 1, 0, 0, -1, &full);
+    stab_refine_finest = 1;
+    run_clip(12, 1, 0, 0, -1, &half);
+    stab_refine_finest = 0;
+    j_full = output_jitter(&full);
+    j_half = output_jitter(&half);
+    printf("    jitter with lookahead 12, refinement ending at full size %.3f px, half size %.3f px\n",
+           j_full, j_half);
+    CHECK(half.latency_ok && half.order_ok && half.inside);
+    CHECK_EQ_INT(half.emitted, CLIP_FRAMES);
+    CHECK_LT(j_half, 1.5 * j_full);
 }
 
 static void test_downscaled_registration(void)
@@ -620,7 +643,7 @@ static void test_api_contract(void)
 
 #define STAB_TESTS(X) \
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
-    X(warp_formats_agree) X(warp_backends_identical) X(warp_plane_end) X(jitter_reduced_causal) X(lookahead_latency_and_gain) \
+    X(warp_formats_agree) X(warp_backends_identical) X(warp_plane_end) X(jitter_reduced_causal) X(lookahead_latency_and_gain) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
     X(deterministic)
 #define ENTRY(name) {#name, test_##name},
