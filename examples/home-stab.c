@@ -32,7 +32,7 @@ static void usage(FILE *f)
             "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 960 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
-            "  --refine-finest L end the refinement at full (0) or half (1) size (default 0)\n"
+            "  --refine-finest L end the refinement at full (0) or half (1) size (default 1)\n"
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
             "                    its 1/2 or 1/4 size copy (2, 4; default: the one about 160 px wide)\n"
             "  --theta-bins N    HOME's theta bins (16..%d; default 88)\n"
