@@ -39,7 +39,7 @@ static void usage(FILE *f)
         "  --hough-downscale N  1: Hough transform of the full image (default); 2 or 4: of a\n"
         "                       2x2- or 4x4-box downscaled copy (4x or 16x less Hough work)\n"
         "  --theta-window N     motion prior: match only keypoints within N theta bins of each\n"
-        "                       other (0 = off, the default; ~27 bins = 10 degrees for video)\n"
+        "                       other (0 = off, the default; --video: 8 of 120 bins = 12 degrees)\n"
         "  --ratio R            Lowe ratio test (default 0.9)\n"
         "  --threshold T        final inlier threshold in Hough pixels (default 1.0)\n"
         "  --threshold-start T  first inlier threshold, halved down to the final (default 64)\n"

@@ -46,7 +46,7 @@ typedef enum home_status {
     HOME_E_ARENA_ALIGN = -6, /* arena not aligned to HOME_ARENA_ALIGN */
     HOME_E_MISMATCH = -7,    /* features from a different image size or config */
     HOME_E_STATE = -8,       /* context or features not initialised (or overwritten) */
-    HOME_E_BUFFER = -9       /* an output buffer is too small */
+    HOME_E_BUFFER = -9       /* reserved: no function returns it today */
 } home_status;
 
 /* Human-readable explanation of a status code (never NULL). */
@@ -122,7 +122,7 @@ int home_validate_config(const home_config *cfg);
 
 typedef struct home_context home_context;
 
-/* Name of the SIMD backend a context uses ("none", "sse", "neon"); with ctx == NULL, the
+/* Name of the SIMD backend a context uses ("none", "sse", "avx2", "neon"); with ctx == NULL, the
  * backend HOME_SIMD_AUTO would pick in this build. */
 const char *home_simd_backend(const home_context *ctx);
 

@@ -124,7 +124,8 @@ typedef struct home_stab home_stab;
 /* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, ease 0.6,
  * downscale 2 for frames wider than 960 px (else 1), then home_video_config()'s choices for the
  * registration image (500 keypoints per sign, automatic hough_downscale: Hough on a copy about
- * 160 px wide) with 88 theta bins, refinement on, ending at half size. */
+ * 160 px wide) with 88 theta bins, a theta window from max_rotation, refinement on with 1024
+ * points, ending at half size. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

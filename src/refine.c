@@ -14,8 +14,9 @@
  * refine_points >> level (at most HOME_REFINE_MAX_POINTS). Flat regions contribute nothing to
  * LK but time.
  *
- * The estimate ends at full resolution, or at the finest level with at least 512 template
- * points (faint texture leaves few points above the noise floor at full resolution).
+ * The estimate ends at level refine_finest_level (0: full resolution), or at the finest coarser
+ * level with at least 512 template points when that one has fewer (faint texture leaves few
+ * points above the noise floor at full resolution).
  *
  * Safeguards (result.refine_status): the refined H replaces HOME's only if that finest level
  * converged within its cap, the estimate is well conditioned (the corners' standard deviation

@@ -108,7 +108,7 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
     h->refine_finest_level = cfg->refine ? cfg->refine_finest_level : 0;
     if (cfg->hough_downscale) h->hough_downscale = cfg->hough_downscale;
     h->simd = cfg->simd;
-    /* 88 instead of the video defaults' 160 theta bins: the refinement gives the precision (on
+    /* 88 instead of the video defaults' 120 theta bins: the refinement gives the precision (on
      * the six bench clips the same jitter and ITF to 0.001 px / 0.01 dB from 120 down to 48
      * bins); 88 is the fewest that keep at least 90 inliers per frame (min_inliers 20, doubled
      * for the downscaled Hough image) on six clips with 10 px / 1 degree shake: 80 left 85.
