@@ -36,6 +36,8 @@ Metrics, all on luma, computed the same way for every method from its output fra
   ITF ends   the same ITF over the first and last 10 pairs only, and over the pairs between
              (where a two-pass method, which sees the whole clip, can slow the output down)
 Usage: python3 bench/stab/compare.py [--quick | --smoke] [--build build] [--frames N] [--out DIR]
+         [--size WxH]   (frame size, default 640x360: the scene 1.25x as large, shake and pan
+                         scaled with the width)
          [--methods home-stab,home-stab la15,vidstab,deshake] [--stab-args "--theta-bins 64"]
          [--repeat N]   (fps columns from the fastest of N runs per method and clip: on a shared
                          machine single runs vary by 10-50 %)
@@ -55,6 +57,7 @@ REPO = Path(__file__).resolve().parents[2]
 W, H = 640, 360
 SCENE_W, SCENE_H = 800, 450
 HALF_DIAG = 0.5 * np.hypot(W, H)
+ALIGN_LEVELS = 3   # pyramid levels of the metric's alignment: the coarsest about 160 px wide
 PHOTOS = {
     "structured": [("building.jpg", 0.0), ("leuvenA.jpg", 0.0)],
     "textured": [("baboon.jpg", 0.0), ("fruits.jpg", 0.0)],
@@ -143,8 +146,9 @@ def sim_matrix(p, cx, cy):
     return np.array([[a, -b, cx + tx - a * cx + b * cy], [b, a, cy + ty - b * cx - a * cy], [0, 0, 1.0]])
 
 
-def align(out_img, in_pyr, p0, levels=3, iters=12):
+def align(out_img, in_pyr, p0, iters=12):
     """Gauss-Newton on (a, b, tx, ty) about the centre, coarse to fine; returns p, M, rms."""
+    levels = len(in_pyr)
     out_pyr = pyramid(out_img, levels)
     p = np.array(p0, float)
     rms = 0.0
@@ -189,7 +193,7 @@ def output_maps(outs, ins):
     maps = []
     p_prev = None
     for t, (o, i) in enumerate(zip(outs, ins)):
-        in_pyr = pyramid(i, 3)
+        in_pyr = pyramid(i, ALIGN_LEVELS)
         if p_prev is None:
             best = None
             for z in (1.0, 0.9, 0.8, 0.7):
@@ -283,6 +287,23 @@ def measure(outs, ins, truth, intended):
 
 # ---- the run ---------------------------------------------------------------------------------
 
+def set_size(text):
+    """Frame and scene size for the run (module globals: the metrics use them)."""
+    global W, H, SCENE_W, SCENE_H, HALF_DIAG, ALIGN_LEVELS
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        sys.exit("--size: expected WxH, got %r" % text)
+    if w < 320 or h < 180 or w % 2 or h % 2:
+        sys.exit("--size: even and at least 320x180, got %r" % text)
+    W, H = w, h
+    SCENE_W, SCENE_H = (w * 5 // 4 + 1) // 2 * 2, (h * 5 // 4 + 1) // 2 * 2
+    HALF_DIAG = 0.5 * np.hypot(W, H)
+    # a frame's change of M_t at 1080p is 3x that at 640x360: without the extra levels the fit
+    # started from the previous frame's map fell into a wrong minimum on fine texture
+    ALIGN_LEVELS = 1 + int(round(np.log2(W / 160.0)))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build")
@@ -295,7 +316,9 @@ def main():
                     help="comma-separated subset of the methods to run")
     ap.add_argument("--stab-args", default="", help="extra home-stab options (e.g. --theta-bins 64)")
     ap.add_argument("--repeat", type=int, default=1, help="run each method N times, fps from the fastest")
+    ap.add_argument("--size", default="%dx%d" % (W, H), help="frame size WxH (even, at least 320x180)")
     args = ap.parse_args()
+    set_size(args.size)
     build = REPO / args.build
     work = Path(args.out) if args.out else build / "bench-stab"
     work.mkdir(parents=True, exist_ok=True)
@@ -329,13 +352,14 @@ def main():
             continue
         for k, (name, decay) in enumerate(items[:1] if args.quick or args.smoke else items):
             stem = "%s_%s" % (cat, Path(name).stem)
-            pgm = work / ("%s.pgm" % Path(name).stem)
+            pgm = work / ("%s_%dx%d.pgm" % (Path(name).stem, SCENE_W, SCENE_H))
             if not pgm.exists():
                 run(["ffmpeg", "-v", "error", "-y", "-i", str(photos / name), "-vf",
                      "scale=%d:%d:force_original_aspect_ratio=increase,crop=%d:%d,format=gray" % (SCENE_W, SCENE_H, SCENE_W, SCENE_H),
                      str(pgm)])
             c, truth_csv = work / (stem + ".y4m"), work / (stem + "_truth.csv")
-            run([str(clip), "--scene", str(pgm), "--frames", str(frames), "--shake", "4", "--rot", "0.3", "--pan", "60",
+            run([str(clip), "--scene", str(pgm), "--frames", str(frames), "--width", str(W), "--height", str(H),
+                 "--shake", "%g" % (4 * W / 640), "--rot", "0.3", "--pan", "%g" % (60 * W / 640),
                  "--decay", str(decay), "--noise", "2", "--seed", str(11 + k), str(c), str(truth_csv)])
             ins = read_y4m_luma(c)
             truth = read_truth(truth_csv)
