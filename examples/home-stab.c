@@ -25,7 +25,7 @@ static void usage(FILE *f)
             "usage: home-stab [options] IN.y4m OUT.y4m      (- for stdin / stdout)\n"
             "  --margin F        crop margin per side, fraction of the frame (default 0.10)\n"
             "  --smoothing F     path smoothing time constant, frames (default: lookahead / 2, at\n"
-            "                    least 3; 15 without lookahead)\n"
+            "                    least 3; 15 with a lookahead below 5 or none)\n"
             "  --lookahead N     frames of latency for fixed-lag smoothing (default 0)\n"
             "  --ease F          with a lookahead: share of the pan given up at the clip's ends,\n"
             "                    0 (keep panning) .. 1 (start from and come to rest); default 0.6\n"

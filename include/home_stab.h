@@ -58,7 +58,8 @@ typedef struct home_stab_config {
     float margin;             /* crop margin on each side, fraction of the side; 0.10 */
     float smoothing;          /* path smoothing time constant in frames (Kalman bandwidth
                                  1/smoothing per frame); larger = steadier, more crop used;
-                                 0 = automatic: lookahead / 2 (at least 3), causal 15 */
+                                 0 = automatic: lookahead / 2 (at least 3); with a
+                                 lookahead below 5 (or causal) 15 */
     int lookahead;            /* frames of latency used for fixed-lag smoothing; 0 = causal */
     float ease;               /* with a lookahead: share of the pan the virtual camera gives up
                                  at the stream's ends, 0..1 (0: the pan goes on through the
