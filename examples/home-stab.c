@@ -1,11 +1,14 @@
 /* home-stab: offline stabilisation of a Y4M stream (4:2:0, 4:2:2 or mono) with libhome.
  *   ffmpeg -i in.mp4 -f yuv4mpegpipe - | home-stab - - | ffmpeg -i - out.mp4
- * The output has the input's size: the crop window is scaled to fill the frame. */
+ * The output has the input's size: the crop window is scaled to fill the frame.
+ * With --threads 2 a second thread warps and writes frame t while the first reads and registers
+ * the next ones: the same bytes out, sooner, for some more CPU time (bench/stab/README.md). */
 #define _POSIX_C_SOURCE 200809L
 #include "home_stab.h"
 #include "stab_png.h"
 #include "y4m.h"
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,6 +44,8 @@ static void usage(FILE *f)
             "                    log scale), share of the correction applied, and the warp\n"
             "                    (output pixel -> input pixel, affine, w00..w12)\n"
             "  --plot FILE.png   plot of the raw and smoothed path\n"
+            "  --threads N       1 (default): register, warp and write in turn; 2: warp and write\n"
+            "                    on a second thread, overlapping the next registrations (same output)\n"
             "  --quiet           no progress on stderr\n"
             "Exit: 0 ok; 1 input ended with a malformed or truncated frame (the frames before it\n"
             "are written); 2 bad usage or unreadable input.\n", HOME_MAX_THETA_BINS);
@@ -55,17 +60,29 @@ static int number(const char *s, double lo, double hi, double *out)
     return 0;
 }
 
+/* Outputs waiting for the writer thread; a few suffice: registration is the slower half. */
+#define WRITE_QUEUE 4
+
 typedef struct app {
     y4m_info info;
     FILE *out, *csv;
     int side_by_side, quiet;
     size_t frame_bytes;
-    uint8_t **ring;               /* lookahead + 1 input frames */
+    uint8_t **ring;               /* lookahead + 1 input frames, + WRITE_QUEUE with a writer thread */
     int ring_len;
     uint8_t *result, *wide;
     int *inliers;                 /* per ring slot: the frame's registration inliers */
     stab_path_plot plot;
-    long written;
+    long written;                 /* frames written (by the writer thread when there is one) */
+    double ms_warp;               /* time in write_output(): warp, side by side, write */
+    /* the writer thread: the reader queues outputs and reuses a ring slot only once its frame
+     * has been written; everything write_output() touches belongs to the writer meanwhile */
+    int threaded, closed, failed;
+    pthread_t writer;
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    home_stab_output queue[WRITE_QUEUE];
+    long queued;                  /* outputs handed to the writer; it has written `written` */
 } app;
 
 static const char *status_name(int s)
@@ -94,6 +111,7 @@ static int write_output(app *ap, const home_stab_output *o)
     const uint8_t *src = ap->ring[o->frame % ap->ring_len];
     home_stab_image in, out;
     int status;
+    double t0 = now_ms(NULL);
     y4m_image(&ap->info, ap->info.width, (uint8_t *)src, &in);
     y4m_image(&ap->info, ap->info.width, ap->result, &out);
     status = home_stab_warp(o->warp, &in, &out);
@@ -117,8 +135,76 @@ static int write_output(app *ap, const home_stab_output *o)
                 o->smooth.angle, o->smooth.log_scale, o->correction_used, o->warp[0], o->warp[1],
                 o->warp[2], o->warp[3], o->warp[4], o->warp[5]);
     stab_plot_add(&ap->plot, &o->raw, &o->smooth);
-    ap->written++;
+    ap->ms_warp += now_ms(NULL) - t0;
     return 0;
+}
+
+static void *writer_main(void *arg)
+{
+    app *ap = arg;
+    pthread_mutex_lock(&ap->lock);
+    for (;;) {
+        home_stab_output o;
+        int bad;
+        while (ap->written == ap->queued && !ap->closed) pthread_cond_wait(&ap->changed, &ap->lock);
+        if (ap->written == ap->queued) break;   /* closed and drained */
+        o = ap->queue[ap->written % WRITE_QUEUE];
+        pthread_mutex_unlock(&ap->lock);
+        bad = write_output(ap, &o);
+        pthread_mutex_lock(&ap->lock);
+        if (bad) { ap->failed = 1; pthread_cond_broadcast(&ap->changed); break; }
+        ap->written++;                           /* frees its queue entry and ring slot */
+        pthread_cond_broadcast(&ap->changed);
+    }
+    pthread_mutex_unlock(&ap->lock);
+    return NULL;
+}
+
+/* Write o's frame, or hand it to the writer thread (waiting while its queue is full). */
+static int emit_output(app *ap, const home_stab_output *o)
+{
+    int bad;
+    if (!ap->threaded) {
+        if (write_output(ap, o)) return -1;
+        ap->written++;
+        return 0;
+    }
+    pthread_mutex_lock(&ap->lock);
+    while (!ap->failed && ap->queued - ap->written >= WRITE_QUEUE) pthread_cond_wait(&ap->changed, &ap->lock);
+    if (!(bad = ap->failed)) {
+        ap->queue[ap->queued % WRITE_QUEUE] = *o;
+        ap->queued++;
+        pthread_cond_broadcast(&ap->changed);
+    }
+    pthread_mutex_unlock(&ap->lock);
+    return bad ? -1 : 0;
+}
+
+/* Wait until frame n may be read into its ring slot: the frame before it there is written. */
+static int slot_free(app *ap, long n)
+{
+    int bad;
+    if (!ap->threaded) return 0;
+    pthread_mutex_lock(&ap->lock);
+    while (!ap->failed && ap->written < n - ap->ring_len + 1) pthread_cond_wait(&ap->changed, &ap->lock);
+    bad = ap->failed;
+    pthread_mutex_unlock(&ap->lock);
+    return bad ? -1 : 0;
+}
+
+/* Let the writer drain its queue and end; 0 when everything queued was written. */
+static int finish_writer(app *ap)
+{
+    if (!ap->threaded) return 0;
+    pthread_mutex_lock(&ap->lock);
+    ap->closed = 1;
+    pthread_cond_broadcast(&ap->changed);
+    pthread_mutex_unlock(&ap->lock);
+    pthread_join(ap->writer, NULL);
+    pthread_cond_destroy(&ap->changed);
+    pthread_mutex_destroy(&ap->lock);
+    ap->threaded = 0;
+    return ap->failed ? -1 : 0;
 }
 
 int main(int argc, char **argv)
@@ -126,8 +212,8 @@ int main(int argc, char **argv)
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
     home_stab_config cfg;
     double margin = 0.10, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0,
-           theta_bins = 0, ease = -1, refine_finest = -1;
-    double t_start, ms_reg = 0, ms_warp = 0, last_report;
+           theta_bins = 0, ease = -1, refine_finest = -1, threads = 1;
+    double t_start, ms_reg = 0, last_report;
     app ap;
     home_stab *stab = NULL;
     home_stab_output o;
@@ -164,6 +250,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--hough-downscale")) { target = &hough_ds; lo = 1; hi = 4; }
         else if (!strcmp(a, "--theta-bins")) { target = &theta_bins; lo = 16; hi = HOME_MAX_THETA_BINS; }
         else if (!strcmp(a, "--keypoints")) { target = &keypoints; lo = 16; hi = HOME_MAX_KEYPOINTS_PER_SIGN; }
+        else if (!strcmp(a, "--threads")) { target = &threads; lo = 1; hi = 2; }
         else { fprintf(stderr, "home-stab: unknown option %s (see --help)\n", a); return 2; }
         if (number(argv[++i], lo, hi, target)) {
             fprintf(stderr, "home-stab: bad value for %s: %s (%g..%g)\n", a, argv[i], lo, hi);
@@ -197,7 +284,7 @@ int main(int argc, char **argv)
     need = home_stab_arena_size(&cfg);
     if (posix_memalign(&arena, HOME_ARENA_ALIGN, need)) arena = NULL;
     ap.frame_bytes = y4m_frame_bytes(&ap.info);
-    ap.ring_len = cfg.lookahead + 1;
+    ap.ring_len = cfg.lookahead + 1 + (threads > 1 ? WRITE_QUEUE : 0);
     ap.ring = calloc((size_t)ap.ring_len, sizeof *ap.ring);
     ap.inliers = calloc((size_t)ap.ring_len, sizeof *ap.inliers);
     ap.result = malloc(ap.frame_bytes);
@@ -217,12 +304,20 @@ int main(int argc, char **argv)
                         "smooth_ty,smooth_angle,smooth_log_scale,correction_used,w00,w01,w02,w10,w11,w12\n");
     }
     y4m_write_header(ap.out, &ap.info, ap.side_by_side ? 2 * ap.info.width : ap.info.width);
+    if (threads > 1) {
+        if (pthread_mutex_init(&ap.lock, NULL) || pthread_cond_init(&ap.changed, NULL) ||
+            pthread_create(&ap.writer, NULL, writer_main, &ap)) {
+            fprintf(stderr, "home-stab: cannot start the writer thread\n");
+            return 2;
+        }
+        ap.threaded = 1;
+    }
 
     t_start = last_report = now_ms(NULL);
     for (;;) {
         uint8_t *buf = ap.ring[frames % ap.ring_len];
         home_stab_image im;
-        double t0;
+        if (slot_free(&ap, frames)) { rc = 2; break; }
         got = y4m_read_frame(in, &ap.info, buf, err, sizeof err);
         if (got == 0) break;
         if (got < 0) {
@@ -238,24 +333,28 @@ int main(int argc, char **argv)
         failed += o.newest_status == HOME_STAB_MOTION_FAILED || o.newest_status == HOME_STAB_MOTION_IMPLAUSIBLE;
         ms_reg += o.ms_register;
         frames++;
-        t0 = now_ms(NULL);
-        if (o.ready && write_output(&ap, &o)) { rc = 2; break; }
-        ms_warp += now_ms(NULL) - t0;
+        if (o.ready && emit_output(&ap, &o)) { rc = 2; break; }
         if (!ap.quiet && now_ms(NULL) - last_report >= 1000.0) {
+            double ms_warp, written;
+            if (ap.threaded) pthread_mutex_lock(&ap.lock);
+            ms_warp = ap.ms_warp;
+            written = (double)ap.written;
+            if (ap.threaded) pthread_mutex_unlock(&ap.lock);
             last_report = now_ms(NULL);
             fprintf(stderr, "home-stab: frame %ld, %.1f fps, register %.1f ms, warp %.1f ms, %ld held\n",
                     frames, frames * 1e3 / (last_report - t_start), ms_reg / frames,
-                    ms_warp / frames, failed);
+                    written > 0 ? ms_warp / written : 0.0, failed);
         }
     }
     while (rc != 2 && home_stab_flush(stab, &o) == HOME_OK && o.ready)
-        if (write_output(&ap, &o)) { rc = 2; break; }
+        if (emit_output(&ap, &o)) { rc = 2; break; }
+    if (finish_writer(&ap)) rc = 2;
     if (fflush(ap.out) != 0) { fprintf(stderr, "home-stab: write error\n"); rc = 2; }
     if (!ap.quiet)
         fprintf(stderr, "home-stab: %ld frames in, %ld out, %.1f fps, register %.1f ms/frame, "
                         "warp %.1f ms/frame, %ld held (registration failed or implausible)\n",
                 frames, ap.written, frames * 1e3 / (now_ms(NULL) - t_start + 1e-9),
-                frames ? ms_reg / frames : 0.0, frames ? ms_warp / frames : 0.0, failed);
+                frames ? ms_reg / frames : 0.0, ap.written ? ap.ms_warp / ap.written : 0.0, failed);
     if (plot_path && stab_plot_write(&ap.plot, plot_path, ap.info.width, ap.info.height)) {
         fprintf(stderr, "home-stab: cannot write %s\n", plot_path);
         rc = 2;

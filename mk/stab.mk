@@ -10,7 +10,7 @@ $(BUILD)/obj/port/stab_avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 
 $(BUILD)/bin/home-stab: $(BUILD)/obj/examples/home-stab.o $(STAB_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) -pthread
 
 $(BUILD)/bin/home-stab-clip: $(BUILD)/obj/examples/stab-make-clip.o $(STAB_SUPPORT)
 	@mkdir -p $(dir $@)

@@ -47,6 +47,21 @@ if cat "$stab_dir/clip.y4m" | $stab --quiet - - > "$stab_dir/piped.y4m" && cmp -
   ok stab_cli_pipes; else fail stab_cli_pipes "stdin/stdout output differs from file output"; fi
 if $stab --quiet --lookahead 6 "$stab_dir/clip.y4m" "$stab_dir/la.y4m" && [ "$(y4m_shape "$stab_dir/la.y4m")" = "24 320 180 420jpeg" ]; then
   ok stab_cli_lookahead_drains; else fail stab_cli_lookahead_drains "$(y4m_shape "$stab_dir/la.y4m")"; fi
+# the writer thread (--threads 2) changes nothing but the wall time: the same bytes as one thread,
+# and a failing output ends the run with exit 2 instead of hanging either thread
+if $stab --quiet --threads 1 --lookahead 6 --side-by-side --csv "$stab_dir/t1.csv" "$stab_dir/clip.y4m" "$stab_dir/t1.y4m" &&
+   $stab --quiet --threads 2 --lookahead 6 --side-by-side --csv "$stab_dir/t2.csv" "$stab_dir/clip.y4m" "$stab_dir/t2.y4m" &&
+   cmp -s "$stab_dir/t1.y4m" "$stab_dir/t2.y4m" && cmp -s "$stab_dir/t1.csv" "$stab_dir/t2.csv" &&
+   [ "$(y4m_shape "$stab_dir/t2.y4m")" = "24 640 180 420jpeg" ]; then
+  ok stab_cli_threads_same_bytes; else fail stab_cli_threads_same_bytes "--threads 1 and 2 differ"; fi
+full_ok=1
+if [ -w /dev/full ]; then
+  for t in 1 2; do
+    timeout 120 $stab --quiet --threads $t --lookahead 3 "$stab_dir/clip.y4m" /dev/full 2> "$stab_dir/e"; st=$?
+    { [ $st -eq 2 ] && grep -q 'write error' "$stab_dir/e"; } || { full_ok=0; echo "    --threads $t to /dev/full: exit $st"; }
+  done
+fi
+if [ $full_ok -eq 1 ]; then ok stab_cli_write_error_exits; else fail stab_cli_write_error_exits "no clean exit 2"; fi
 python3 - "$stab_dir/clip.y4m" "$stab_dir/c422.y4m" <<'PY'
 import sys
 d = open(sys.argv[1], 'rb').read(); nl = d.index(b'\n')
@@ -69,6 +84,11 @@ head -c $((header_bytes + 10 * frame_bytes + 5000)) "$stab_dir/clip.y4m" > "$sta
 $stab --quiet "$stab_dir/trunc.y4m" "$stab_dir/trunc_out.y4m" 2> "$stab_dir/err"; st=$?
 if [ $st -eq 1 ] && grep -q 'truncated' "$stab_dir/err" && [ "$(y4m_shape "$stab_dir/trunc_out.y4m")" = "10 320 180 420jpeg" ]; then
   ok stab_cli_truncated_keeps_frames; else fail stab_cli_truncated_keeps_frames "exit $st, $(y4m_shape "$stab_dir/trunc_out.y4m"), $(cat "$stab_dir/err")"; fi
+$stab --quiet --threads 2 --lookahead 4 "$stab_dir/trunc.y4m" "$stab_dir/trunc_t2.y4m" 2> /dev/null; st2=$?
+$stab --quiet --threads 1 --lookahead 4 "$stab_dir/trunc.y4m" "$stab_dir/trunc_t1.y4m" 2> /dev/null; st1=$?
+if [ $st1 -eq 1 ] && [ $st2 -eq 1 ] && cmp -s "$stab_dir/trunc_t1.y4m" "$stab_dir/trunc_t2.y4m" &&
+   [ "$(y4m_shape "$stab_dir/trunc_t2.y4m")" = "10 320 180 420jpeg" ]; then
+  ok stab_cli_truncated_threads; else fail stab_cli_truncated_threads "exit $st1 / $st2, $(y4m_shape "$stab_dir/trunc_t2.y4m")"; fi
 { head -c $((header_bytes + 7 * frame_bytes)) "$stab_dir/clip.y4m"; printf 'FRAMX\n'; head -c 100 /dev/zero; } > "$stab_dir/bad_marker.y4m"
 $stab --quiet "$stab_dir/bad_marker.y4m" "$stab_dir/bm_out.y4m" 2> "$stab_dir/err"; st=$?
 if [ $st -eq 1 ] && grep -q 'malformed' "$stab_dir/err" && [ "$(y4m_shape "$stab_dir/bm_out.y4m")" = "7 320 180 420jpeg" ]; then
