@@ -156,6 +156,13 @@ int home_stab_reset(home_stab *stab);
  * affine or sends the frame further than one frame size outside the source. */
 int home_stab_warp(const double *warp, const home_stab_image *src, home_stab_image *dst);
 
+/* home_stab_warp() for the output luma rows first_row .. first_row + rows - 1 only (and their
+ * chroma rows): the same bytes there, nothing else written. Bands on several threads split the
+ * warp across cores (the library keeps no state: any thread may call it). I420 and NV12 bands
+ * start and end on an even row; HOME_E_CONFIG otherwise or outside the frame. */
+int home_stab_warp_rows(const double *warp, const home_stab_image *src, home_stab_image *dst, int first_row,
+                        int rows);
+
 /* Similarity parameters <-> 3x3 matrices (about the centre of a width x height frame). */
 void home_stab_sim_to_matrix(const home_stab_sim *s, int width, int height, double *m);
 

@@ -146,6 +146,11 @@ static int32_t to_q16(double v) { return (int32_t)floor(v * 65536.0 + 0.5); }
 
 int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image *dst)
 {
+    return home_stab_warp_rows(m, src, dst, 0, dst ? dst->height : 0);
+}
+
+int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_image *dst, int first_row, int rows)
+{
     plane_view views[3];
     const home__stab_kernels *kern;
     home_config simd_choice;
@@ -157,6 +162,10 @@ int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image 
         return status;
     if (src->format != dst->format || src->width != dst->width || src->height != dst->height)
         return HOME_E_MISMATCH;
+    /* a band of whole chroma rows: with vertically subsampled chroma it starts and ends even */
+    if (first_row < 0 || rows < 1 || rows > dst->height - first_row) return HOME_E_CONFIG;
+    if ((dst->format == HOME_STAB_I420 || dst->format == HOME_STAB_NV12) && (first_row % 2 || rows % 2))
+        return HOME_E_CONFIG;
     for (k = 0; k < 9; k++)
         if (!isfinite(m[k])) return HOME_E_CONFIG;
     if (m[6] != 0.0 || m[7] != 0.0 || m[8] != 1.0) return HOME_E_CONFIG;
@@ -183,7 +192,9 @@ int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image 
         const double d = m[3] * sx / sy, e = m[4], f = (m[3] * ox + m[4] * oy + m[5] - oy) / sy;
         const int32_t aq = to_q16(a), bq = to_q16(b), cq = to_q16(c);
         const int32_t dq = to_q16(d), eq = to_q16(e), fq = to_q16(f);
-        for (j = 0; j < p->h; j++)
+        /* each row starts from its own index (no running sum): a band's bytes are the whole
+         * warp's */
+        for (j = first_row / p->sub_y; j < (first_row + rows) / p->sub_y; j++)
             kern->warp_row(p->src, p->src_stride, p->step, p->w, p->h, bq * j + cq, eq * j + fq, aq,
                            dq, p->dst + (ptrdiff_t)j * p->dst_stride, p->step, p->w);
     }

@@ -84,6 +84,18 @@ static int push_i420(int drop_chroma)
     return home_stab_push(stab, &sframe, &sout);
 }
 
+/* a band of an I420 warp (source chroma in img_b, destination chroma after it) */
+static int warp_rows_i420(int first_row, int rows)
+{
+    sframe.format = sdst.format = HOME_STAB_I420;
+    sframe.plane[1] = img_b;
+    sframe.plane[2] = img_b + W * H / 4;
+    sdst.plane[1] = img_b + W * H / 2;
+    sdst.plane[2] = img_b + W * H * 3 / 4;
+    sframe.stride[1] = sframe.stride[2] = sdst.stride[1] = sdst.stride[2] = W / 2;
+    return home_stab_warp_rows(warp_m, &sframe, &sdst, first_row, rows);
+}
+
 /* features of another context: a frame of another size, or another config of the same size */
 static int match_foreign(int width, int height, int theta_bins)
 {
@@ -252,6 +264,13 @@ static int y4m(const char *text, size_t size, int frames)
     X(stab_warp_far_outside, HOME_E_CONFIG, (warp_m[2] = 10.0 * W, home_stab_warp(warp_m, &sframe, &sdst))) \
     X(stab_warp_format_mismatch, HOME_E_MISMATCH, (sdst.format = HOME_STAB_YUYV, sdst.stride[0] = 2 * W, home_stab_warp(warp_m, &sframe, &sdst))) \
     X(stab_warp_stride_overflows, HOME_E_STRIDE, (sframe.stride[0] = PTRDIFF_MAX / 2, home_stab_warp(warp_m, &sframe, &sdst))) \
+    X(stab_warp_rows_null_map, HOME_E_NULL, home_stab_warp_rows(NULL, &sframe, &sdst, 0, 2)) \
+    X(stab_warp_rows_none, HOME_E_CONFIG, home_stab_warp_rows(warp_m, &sframe, &sdst, 0, 0)) \
+    X(stab_warp_rows_negative_start, HOME_E_CONFIG, home_stab_warp_rows(warp_m, &sframe, &sdst, -1, 4)) \
+    X(stab_warp_rows_past_the_end, HOME_E_CONFIG, home_stab_warp_rows(warp_m, &sframe, &sdst, H - 2, 3)) \
+    X(stab_warp_rows_int_max, HOME_E_CONFIG, home_stab_warp_rows(warp_m, &sframe, &sdst, 2, INT_MAX)) \
+    X(stab_warp_rows_odd_start_i420, HOME_E_CONFIG, warp_rows_i420(1, 2)) \
+    X(stab_warp_rows_odd_count_i420, HOME_E_CONFIG, warp_rows_i420(2, 3)) \
     /* inspection */ \
     X(hough_size_null_output, HOME_E_NULL, home_hough_size(ctx, &hw, NULL)) \
     X(render_hough_null_output, HOME_E_NULL, home_render_hough(ctx, img_a, W, NULL, 1024)) \

@@ -195,6 +195,13 @@ static void job_stab_warp(void)
     home_stab_warp(shift, &a, &out);
 }
 
+static void job_stab_warp_rows(void)
+{
+    static const double shift[9] = {1, 0, 1.5, 0, 1, -0.5, 0, 0, 1};
+    home_stab_image a = frame_image(da), out = frame_image(s_warped);
+    home_stab_warp_rows(shift, &a, &out, 2, 6);
+}
+
 void test_stack_painted(void)
 {
     static const struct { const char *name; void (*job)(void); } jobs[] = {
@@ -207,6 +214,7 @@ void test_stack_painted(void)
         {"home_simd_backend", job_simd_backend}, {"home_refine", job_refine},
         {"home_stab_init", job_stab_init}, {"home_stab_push (2 frames)", job_stab_push},
         {"home_stab_flush", job_stab_flush}, {"home_stab_warp", job_stab_warp},
+        {"home_stab_warp_rows", job_stab_warp_rows},
     };
     static const int backends[] = {HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
     static const int methods[] = {HOME_HOUGH_FAST, HOME_HOUGH_EXACT};

@@ -497,6 +497,73 @@ static void test_warp_formats_agree(void)
     CHECK_EQ_INT(bad, 0);
 }
 
+/* Warping in bands of rows gives the whole warp's bytes (I420: even bands; YUYV: any), a band
+ * writes nothing outside its rows, and bands that are empty, outside the frame or odd in I420
+ * are refused with the destination untouched. */
+static void test_warp_bands_match_whole(void)
+{
+    static uint8_t i420[CW * CH * 3 / 2], whole[CW * CH * 3 / 2], bands[CW * CH * 3 / 2];
+    static uint8_t yuyv[CW * CH * 2], ywhole[CW * CH * 2], ybands[CW * CH * 2];
+    static const int cuts420[] = {0, 10, 36, 92, CH}, cutsyuyv[] = {0, 7, 8, 101, CH};
+    home_stab_image a, b, c, ya, yb, yc;
+    home_stab_sim s = {-4.1, 2.6, -0.04, 0.06};
+    double m[9];
+    int k, y, outside = 0, inside = 0;
+    render_clip();
+    memcpy(i420, clip[9], sizeof i420);
+    for (k = 0; k < CW * CH / 2; k++) i420[CW * CH + k] = (uint8_t)(k * 7 + (k >> 5));
+    for (k = 0; k < CW * CH; k++) { yuyv[2 * k] = i420[k]; yuyv[2 * k + 1] = (uint8_t)(k * 13); }
+    grey_image(i420, &a); grey_image(whole, &b); grey_image(bands, &c);
+    memset(&ya, 0, sizeof ya);
+    ya.format = HOME_STAB_YUYV; ya.width = CW; ya.height = CH; ya.plane[0] = yuyv; ya.stride[0] = 2 * CW;
+    yb = ya; yb.plane[0] = ywhole;
+    yc = ya; yc.plane[0] = ybands;
+    home_stab_sim_to_matrix(&s, CW, CH, m);
+    CHECK_EQ_INT(home_stab_warp(m, &a, &b), HOME_OK);
+    CHECK_EQ_INT(home_stab_warp(m, &ya, &yb), HOME_OK);
+    memset(bands, 0xA5, sizeof bands);
+    memset(ybands, 0xA5, sizeof ybands);
+    for (k = 0; k + 1 < (int)(sizeof cuts420 / sizeof cuts420[0]); k++) {
+        CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, cuts420[k], cuts420[k + 1] - cuts420[k]), HOME_OK);
+        CHECK_EQ_INT(home_stab_warp_rows(m, &ya, &yc, cutsyuyv[k], cutsyuyv[k + 1] - cutsyuyv[k]), HOME_OK);
+    }
+    CHECK(memcmp(whole, bands, sizeof whole) == 0);
+    CHECK(memcmp(ywhole, ybands, sizeof ywhole) == 0);
+
+    /* one band (luma rows 36..91, chroma rows 18..45) into a sentinel frame */
+    memset(bands, 0xA5, sizeof bands);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, 36, 56), HOME_OK);
+    for (y = 0; y < CH; y++) {
+        const int in = y >= 36 && y < 92;
+        for (k = 0; k < CW; k++) {
+            const uint8_t got = bands[y * CW + k], want = in ? whole[y * CW + k] : 0xA5;
+            outside += !in && got != want;
+            inside += in && got != want;
+        }
+    }
+    for (y = 0; y < CH / 2; y++) {
+        const int in = y >= 18 && y < 46;
+        for (k = 0; k < CW / 2; k++) {
+            const size_t u = (size_t)CW * CH + (size_t)y * (CW / 2) + (size_t)k, v = u + (size_t)CW * CH / 4;
+            outside += !in && (bands[u] != 0xA5 || bands[v] != 0xA5);
+            inside += in && (bands[u] != whole[u] || bands[v] != whole[v]);
+        }
+    }
+    CHECK_EQ_INT(inside, 0);
+    CHECK_EQ_INT(outside, 0);
+
+    memset(bands, 0xA5, sizeof bands);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, 0, 0), HOME_E_CONFIG);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, -2, 4), HOME_E_CONFIG);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, CH - 2, 4), HOME_E_CONFIG);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, 3, 4), HOME_E_CONFIG);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, 4, 3), HOME_E_CONFIG);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &a, &c, 2, 2147483647), HOME_E_CONFIG);
+    CHECK_EQ_INT(home_stab_warp_rows(m, &ya, &yc, 3, 1), HOME_OK);
+    for (k = 0, outside = 0; k < (int)sizeof bands; k++) outside += bands[k] != 0xA5;
+    CHECK_EQ_INT(outside, 0);
+}
+
 static void test_row_kernel_edges(void)
 {
     /* 2x2 source: every clamped coordinate lands on an edge pixel pair with weights 0 or 256 */
@@ -665,7 +732,7 @@ static void test_api_contract(void)
 
 #define STAB_TESTS(X) \
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
-    X(warp_formats_agree) X(warp_backends_identical) X(warp_plane_end) X(jitter_reduced_causal) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
+    X(warp_formats_agree) X(warp_bands_match_whole) X(warp_backends_identical) X(warp_plane_end) X(jitter_reduced_causal) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
     X(deterministic)
 #define ENTRY(name) {#name, test_##name},

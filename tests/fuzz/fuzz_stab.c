@@ -191,6 +191,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         /* an invalid destination (a fuzzed padding can make it one) must be refused */
         if (dst_valid) FZ_CHECK(s == HOME_OK || s == HOME_E_CONFIG);
         else FZ_CHECK(s != HOME_OK);
+        {
+            /* a band of it: done exactly when the whole warp is and the band is whole rows of
+             * the frame (even ones with vertically subsampled chroma) */
+            const int first = fz_range(r, -2, cfg.height + 2), rows = fz_range(r, -1, cfg.height + 2);
+            const int even = fmt != HOME_STAB_I420 && fmt != HOME_STAB_NV12 ? 1 : first % 2 == 0 && rows % 2 == 0;
+            const int band_ok = first >= 0 && rows >= 1 && first + rows <= cfg.height && even;
+            const int sb = home_stab_warp_rows(m, &frames[0], &dst, first, rows);
+            FZ_CHECK(is_status(sb));
+            if (s != HOME_OK) FZ_CHECK(sb != HOME_OK);
+            else FZ_CHECK(band_ok ? sb == HOME_OK : sb == HOME_E_CONFIG);
+        }
         sim.tx = fz_float_bits(r);
         sim.ty = fz_float_bits(r);
         sim.angle = fz_float_bits(r);
