@@ -75,3 +75,9 @@ install: stab-install-header
 stab-install-header:
 	install -d $(DESTDIR)$(PREFIX)/include
 	install -m 644 include/home_stab.h $(DESTDIR)$(PREFIX)/include/
+
+# the warp split across threads in bands (home_stab_warp_rows), against one thread: bench only
+BINS += $(BUILD)/bin/home-warp-bands
+$(BUILD)/bin/home-warp-bands: bench/stab/warp_bands.c $(LIB) include/home_stab.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $< $(LIB) -o $@ $(LDFLAGS_APP) -pthread
