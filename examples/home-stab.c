@@ -75,8 +75,9 @@ typedef struct app {
     stab_path_plot plot;
     long written;                 /* frames written (by the writer thread when there is one) */
     double ms_warp;               /* time in write_output(): warp, side by side, write */
-    /* the writer thread: the reader queues outputs and reuses a ring slot only once its frame
-     * has been written; everything write_output() touches belongs to the writer meanwhile */
+    /* the writer thread: the reader queues outputs (the queue's bound keeps ring slots from
+     * being reused before their frame is written); everything write_output() touches belongs
+     * to the writer meanwhile */
     int threaded, closed, failed;
     pthread_t writer;
     pthread_mutex_t lock;
@@ -180,18 +181,6 @@ static int emit_output(app *ap, const home_stab_output *o)
     return bad ? -1 : 0;
 }
 
-/* Wait until frame n may be read into its ring slot: the frame before it there is written. */
-static int slot_free(app *ap, long n)
-{
-    int bad;
-    if (!ap->threaded) return 0;
-    pthread_mutex_lock(&ap->lock);
-    while (!ap->failed && ap->written < n - ap->ring_len + 1) pthread_cond_wait(&ap->changed, &ap->lock);
-    bad = ap->failed;
-    pthread_mutex_unlock(&ap->lock);
-    return bad ? -1 : 0;
-}
-
 /* Let the writer drain its queue and end; 0 when everything queued was written. */
 static int finish_writer(app *ap)
 {
@@ -284,6 +273,8 @@ int main(int argc, char **argv)
     need = home_stab_arena_size(&cfg);
     if (posix_memalign(&arena, HOME_ARENA_ALIGN, need)) arena = NULL;
     ap.frame_bytes = y4m_frame_bytes(&ap.info);
+    /* frame n is read once outputs 0 .. n - lookahead - 1 were queued, and the queue holds at
+     * most WRITE_QUEUE unwritten ones: its slot's previous frame, n - ring_len, is written */
     ap.ring_len = cfg.lookahead + 1 + (threads > 1 ? WRITE_QUEUE : 0);
     ap.ring = calloc((size_t)ap.ring_len, sizeof *ap.ring);
     ap.inliers = calloc((size_t)ap.ring_len, sizeof *ap.inliers);
@@ -317,7 +308,6 @@ int main(int argc, char **argv)
     for (;;) {
         uint8_t *buf = ap.ring[frames % ap.ring_len];
         home_stab_image im;
-        if (slot_free(&ap, frames)) { rc = 2; break; }
         got = y4m_read_frame(in, &ap.info, buf, err, sizeof err);
         if (got == 0) break;
         if (got < 0) {
