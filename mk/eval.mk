@@ -1,6 +1,11 @@
 # Evaluation against ORB, AKAZE and LSD/LBD on real photographs (bench/eval, Python 3).
 #   make eval        full run: regenerates bench/eval/results.md and its plots
 #   make eval-quick  the CI subset: report in $(EVAL_CACHE)/quick/results.md
+#   make eval-trust        issue 16: can `ok` be trusted? tuning set vs sealed test set, still
+#                          pairs, consecutive frames, static camera; rewrites
+#                          bench/eval/trust_results.md, trust_results.json and trust_*.png
+#   make eval-trust-quick  its CI subset (report in $(EVAL_CACHE)/trust-quick/; fails only when
+#                          the harness breaks, never on the numbers)
 # Photographs come from Debian packages (apt-get download) into $(EVAL_CACHE).
 EVAL_CACHE ?= $(BUILD)/eval-cache
 EVAL_JOBS ?= 2
@@ -9,7 +14,7 @@ EVAL_PIP := numpy 'opencv-contrib-python-headless<5' matplotlib
 EVAL_RUN = $(EVAL_PYTHON) bench/eval/run.py --home $(BUILD)/bin/home-register \
 	--cache $(EVAL_CACHE) --jobs $(EVAL_JOBS)
 
-.PHONY: eval eval-quick eval-deps
+.PHONY: eval eval-quick eval-deps eval-trust eval-trust-quick
 eval-deps:
 	@$(EVAL_PYTHON) -c 'import numpy, matplotlib, cv2; cv2.line_descriptor.LSDDetector_createLSDDetector' 2>/dev/null \
 	|| $(EVAL_PYTHON) -m pip install --quiet $(EVAL_PIP) \
@@ -20,3 +25,15 @@ eval: $(BUILD)/bin/home-register eval-deps
 
 eval-quick: $(BUILD)/bin/home-register eval-deps
 	$(EVAL_RUN) --quick
+
+# EVAL_TRUST_ARGS: more trust.py options, e.g. --sets test --suites static, or
+#   --extra-args "--refine-trust 40" (passed to every home-register run)
+EVAL_TRUST_ARGS ?=
+EVAL_TRUST = $(EVAL_PYTHON) bench/eval/trust.py --home $(BUILD)/bin/home-register \
+	--stab $(BUILD)/bin/home-stab --cache $(EVAL_CACHE) --jobs $(EVAL_JOBS) $(EVAL_TRUST_ARGS)
+
+eval-trust: $(BUILD)/bin/home-register $(BUILD)/bin/home-stab eval-deps
+	$(EVAL_TRUST)
+
+eval-trust-quick: $(BUILD)/bin/home-register $(BUILD)/bin/home-stab eval-deps
+	$(EVAL_TRUST) --quick

