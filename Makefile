@@ -61,7 +61,7 @@ $(BUILD)/obj/port/%.o: port/%.c include/home.h include/home_limits.h port/kernel
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_LIB) -c $< -o $@
 
-$(BUILD)/obj/examples/%.o: examples/%.c include/home.h $(wildcard examples/*.h)
+$(BUILD)/obj/examples/%.o: examples/%.c include/home.h include/home_stab.h include/home_limits.h $(wildcard examples/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) -c $< -o $@
 

@@ -51,6 +51,11 @@ static void usage(FILE *f)
         "                       (default 4096, 64..4096)\n"
         "  --refine-finest L    pyramid level the refinement ends at: 0 full size (default),\n"
         "                       1 half size (--video's; about half the refinement's cost)\n"
+        "  --max-model M        most general motion model: identity, translation, similarity,\n"
+        "                       affine or homography (default); the simplest the data support\n"
+        "                       is reported as \"model\"\n"
+        "  --max-sigma PX       ok needs a predicted RMS corner error (\"sigma_px\") at most\n"
+        "                       this (default 1)\n"
         "  --refine-trust PX    largest corner motion the refinement may make, in Hough-image\n"
         "                       px (default 6)\n"
         "  --repeat N           register N times; ms are medians, plus \"frame\": one new frame\n"
@@ -142,8 +147,8 @@ int main(int argc, char **argv)
     home_config cfg;
     int n_paths = 0, i, repeat = 1, status, s, video = 0;
     int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_rpoints = -1, opt_downscale = -1,
-        opt_window = -1, opt_rfinest = -1;
-    float opt_rtrust = -1;
+        opt_window = -1, opt_rfinest = -1, opt_max_model = -1;
+    float opt_rtrust = -1, opt_max_sigma = -1;
     float opt_ratio = -1, opt_thr = -1, opt_thr0 = -1, opt_rstep = -1, opt_sigma = -1;
     uint8_t *buf_a = NULL, *buf_b = NULL;
     const uint8_t *pa, *pb;
@@ -172,6 +177,13 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--refine-points")) bad = parse_int(v, &opt_rpoints), i++;
         else if (!strcmp(a, "--refine-finest")) bad = parse_int(v, &opt_rfinest), i++;
         else if (!strcmp(a, "--refine-trust")) bad = parse_float(v, &opt_rtrust), i++;
+        else if (!strcmp(a, "--max-sigma")) bad = parse_float(v, &opt_max_sigma), i++;
+        else if (!strcmp(a, "--max-model")) {
+            for (opt_max_model = HOME_MODEL_HOMOGRAPHY; opt_max_model >= 0; opt_max_model--)
+                if (!strcmp(v, home_model_name(opt_max_model))) break;
+            bad = opt_max_model < 0;
+            i++;
+        }
         else if (!strcmp(a, "--repeat")) bad = parse_int(v, &repeat) || repeat < 1 || repeat > 10000, i++;
         else if (!strcmp(a, "--ratio")) bad = parse_float(v, &opt_ratio), i++;
         else if (!strcmp(a, "--threshold")) bad = parse_float(v, &opt_thr), i++;
@@ -216,6 +228,8 @@ int main(int argc, char **argv)
     if (opt_rpoints >= 0) cfg.refine_points = opt_rpoints;
     if (opt_rfinest >= 0) cfg.refine_finest_level = opt_rfinest;
     if (opt_rtrust >= 0) cfg.refine_trust_px = opt_rtrust;
+    if (opt_max_sigma >= 0) cfg.max_sigma_px = opt_max_sigma;
+    if (opt_max_model >= 0) cfg.max_model = opt_max_model;
     if (cfg.wrap_band > cfg.theta_bins / 4) cfg.wrap_band = cfg.theta_bins / 18;
     cfg.clock = clock_ms;
     if ((status = home_validate_config(&cfg)) != HOME_OK) {
@@ -270,9 +284,15 @@ int main(int argc, char **argv)
         for (i = 0; i < 9; i++) printf("%s%.10g", i ? "," : "", res.H[i]);
         printf("]");
     }
-    printf(",\"keypoints\":[%d,%d],\"matches\":%d,\"inliers\":%d,\"refined\":%s,\"ms\":{",
+    printf(",\"keypoints\":[%d,%d],\"matches\":%d,\"inliers\":%d,\"refined\":%s",
            res.keypoints_a, res.keypoints_b, res.matches, res.inliers,
            res.refined ? "true" : "false");
+    printf(",\"model\":\"%s\",\"sigma_px\":", home_model_name(res.model));
+    if (isfinite(res.sigma_px)) printf("%.6g", res.sigma_px);
+    else printf("null"); /* not determined: JSON has no infinity */
+    printf(",\"failure\":\"%s\",\"refine_status\":\"%s\",\"refine_zncc\":%.4f,\"ms\":{",
+           home_failure_name(res.failure), home_refine_status_name(res.refine_status),
+           res.refine_zncc);
     for (s = 0; s < HOME_STAGE_COUNT; s++) printf("%s\"%s\":%.3f", s ? "," : "", stage_names[s], ms[s]);
     if (repeat > 1) printf(",\"frame\":%.3f", frame_ms);
     printf("}}\n");

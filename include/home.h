@@ -67,6 +67,18 @@ enum home_simd { HOME_SIMD_AUTO = 0, HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_NE
  * nearest r bins), the slow reference. */
 enum home_hough_method { HOME_HOUGH_FAST = 0, HOME_HOUGH_EXACT };
 
+/* Motion models, simplest first (result.model; cfg.max_model caps the choice). */
+enum home_model {
+    HOME_MODEL_IDENTITY = 0,  /* no motion */
+    HOME_MODEL_TRANSLATION,   /* 2 parameters */
+    HOME_MODEL_SIMILARITY,    /* rotation, isotropic scale, translation: 4 */
+    HOME_MODEL_AFFINE,        /* 6 */
+    HOME_MODEL_HOMOGRAPHY     /* 8 */
+};
+
+/* Name of a model ("identity", ..., "homography"; "unknown" when out of range). */
+const char *home_model_name(int model);
+
 typedef struct home_config {
     int width, height;        /* image size; both frames of a pair must have it */
     int theta_bins;           /* bins over [0, pi); paper: 480 */
@@ -84,8 +96,10 @@ typedef struct home_config {
     /* photometric refinement of HOME's H (home_refine() below); refine_levels = 0 turns it off */
     int refine_levels;        /* pyramid levels, 1..HOME_REFINE_MAX_LEVELS; default 3 */
     int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
-    float refine_trust_px;    /* largest corner motion from HOME's H accepted, in px of the
-                                 Hough image (x hough_downscale in the image); default 6 */
+    float refine_trust_px;    /* corner motion from HOME's H the refinement may always make,
+                                 in px of the Hough image (x hough_downscale in the image);
+                                 beyond it, and beyond 3x HOME's predicted error, the two
+                                 disagree (see the failure rule at home_match); default 6 */
     int refine_points;        /* template points at full resolution (halved per coarser level,
                                  at least 64), 64..HOME_REFINE_MAX_POINTS; default the maximum
                                  (4096): fewer cost proportionally less per iteration */
@@ -98,6 +112,10 @@ typedef struct home_config {
                                  4x4-box downscaled copy (FAST only): 4x or 16x less Hough work,
                                  for video on small cores (the photometric refinement restores
                                  full-resolution precision); r bins are then ds*r_step px */
+    int max_model;            /* enum home_model: the most general model considered; default
+                                 HOMOGRAPHY (the stabiliser asks for SIMILARITY) */
+    float max_sigma_px;       /* ok needs a predicted RMS corner error (result.sigma_px) at
+                                 most this, px; 0.02..100, default 1 */
     int match_theta_window;   /* video motion prior: 0 = off (default, still pairs); N > 0 =
                                  a keypoint is only compared with keypoints whose theta lies
                                  within N bins of its own (the frame rotates less than that) */
@@ -175,10 +193,17 @@ enum home_failure {
     HOME_FAIL_FEW_MATCHES,    /* too few matches to estimate a homography */
     HOME_FAIL_FEW_INLIERS,    /* fewer than min_inliers (2x with hough_downscale > 1) at the
                                  final threshold */
-    HOME_FAIL_DEGENERATE      /* det(H / H22) <= 0, an image corner mapped behind the camera
+    HOME_FAIL_DEGENERATE,     /* det(H / H22) <= 0, an image corner mapped behind the camera
                                  (w <= 0), the frame mapped to a non-convex, flipped or
                                  collapsed quadrilateral, or a numerically unusable estimate */
+    HOME_FAIL_UNCERTAIN,      /* no model up to max_model is determined by the inliers, or the
+                                 predicted error (sigma_px) is above max_sigma_px */
+    HOME_FAIL_INCONSISTENT    /* the refinement converged far from HOME's estimate (beyond
+                                 its uncertainty) and cannot vouch for its own */
 };
+
+/* Name of a failure ("none", "few_matches", ...; "unknown" when out of range). */
+const char *home_failure_name(int failure);
 
 /* What the photometric refinement did (result.refine_status). */
 enum home_refine_status {
@@ -192,16 +217,24 @@ enum home_refine_status {
     HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above 0.5 px (predicted, or from
                                      two interleaved halves of the points), or the refined H
                                      fails HOME_FAIL_DEGENERATE's plausibility rule */
-    HOME_REFINE_OUTSIDE_TRUST,    /* a corner left the trust region (refine_trust_px) */
+    HOME_REFINE_OUTSIDE_TRUST,    /* the refined H is farther from HOME's than refine_trust_px
+                                     and 3x HOME's sigma_px, and cannot vouch for itself */
     HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
     HOME_REFINE_LOW_CORRELATION   /* HOME failed and the refinement cannot vouch (rule below) */
 };
+
+/* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */
+const char *home_refine_status_name(int status);
 
 typedef struct home_result {
     int ok;                   /* 1: H is trustworthy by the failure rule */
     int failure;              /* enum home_failure */
     double H[9];              /* A -> B, row-major, H[8] = 1; when not ok, the rejected
                                  estimate (identity if there was none) */
+    int model;                /* enum home_model of H (of the rejected estimate when not ok) */
+    double sigma_px;          /* predicted RMS error of H at the image corners, px, from the
+                                 final fit's covariance (the line fit's, or the refinement's
+                                 when refined); infinite when the motion is not determined */
     int keypoints_a, keypoints_b, matches, inliers;
     int refined;              /* 1: H is HOME's estimate refined photometrically */
     int refine_status;        /* enum home_refine_status */
@@ -221,10 +254,16 @@ typedef struct home_result {
  * HOME_REFINE_NO_SNAPSHOT and keeps HOME's H. Extract + match gives the same H as
  * home_register() on the same images.
  *
- * Failure rule with refinement: ok as HOME's rule says; in addition, a pair HOME rejects only
- * for too few inliers (HOME_FAIL_FEW_INLIERS, at least 8 inliers) becomes ok when the
- * refinement is accepted and refine_zncc >= 0.9: the photometric fit vouches for the estimate.
- * When HOME failed, H stays HOME's unless that rescue applies. */
+ * Model and accuracy: each fit (lines, then photometric) chooses the simplest model up to
+ * cfg.max_model that its data support (BIC over the fit's Fisher information) and predicts the
+ * RMS corner error sigma_px from its covariance. ok requires sigma_px <= cfg.max_sigma_px.
+ *
+ * Failure rule with refinement: HOME's estimate (ok, or short of inliers or certainty with at
+ * least 8 inliers) is refined. An accepted refinement within max(refine_trust_px, 3 sigma_px)
+ * of HOME's H agrees with it: the result is the refined H, ok when HOME's was, or when the
+ * photometric fit vouches for it (refine_zncc >= 0.9). Farther away the two disagree: the
+ * refined H is the result only when it vouches for itself, else the pair fails
+ * (HOME_FAIL_INCONSISTENT). A declined refinement leaves HOME's H, sigma and ok. */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 

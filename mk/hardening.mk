@@ -20,7 +20,7 @@ $(HARD_TESTS): $(HARD_TEST_OBJ) $(BUILD)/obj/tests/test_runner.o $(FUZZ_SUPPORT)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) -pthread
 
 FUZZ_TARGET_LIST := $(foreach t,$(FUZZ_TARGETS),X($(t)))
-$(BUILD)/obj/fuzz-replay/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h include/home.h $(wildcard examples/*.h)
+$(BUILD)/obj/fuzz-replay/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h include/home.h include/home_stab.h $(wildcard examples/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) -DLLVMFuzzerTestOneInput=fuzz_$*_one -c $< -o $@
 

@@ -17,7 +17,7 @@ $(BUILD)/bin/home-stab-clip: $(BUILD)/obj/examples/stab-make-clip.o $(STAB_SUPPO
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
 # its own object directory: the generic tests/ rule builds home-tests' objects
-$(BUILD)/obj/tests/stab/test_stab.o: tests/test_stab.c include/home_stab.h port/stab_kernels.h $(wildcard tests/*.h examples/*.h)
+$(BUILD)/obj/tests/stab/test_stab.o: tests/test_stab.c include/home.h include/home_stab.h include/home_limits.h port/stab_kernels.h $(wildcard tests/*.h examples/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) -Isrc -Iport -DHOME_STAB_TESTS -c $< -o $@
 

@@ -21,6 +21,36 @@ const char *home_strerror(int status)
     }
 }
 
+const char *home_failure_name(int failure)
+{
+    switch (failure) {
+    case HOME_FAIL_NONE: return "none";
+    case HOME_FAIL_FEW_MATCHES: return "few_matches";
+    case HOME_FAIL_FEW_INLIERS: return "few_inliers";
+    case HOME_FAIL_DEGENERATE: return "degenerate";
+    case HOME_FAIL_UNCERTAIN: return "uncertain";
+    case HOME_FAIL_INCONSISTENT: return "inconsistent";
+    default: return "unknown";
+    }
+}
+
+const char *home_refine_status_name(int status)
+{
+    switch (status) {
+    case HOME_REFINE_OFF: return "off";
+    case HOME_REFINE_ACCEPTED: return "accepted";
+    case HOME_REFINE_NO_ESTIMATE: return "no_estimate";
+    case HOME_REFINE_NO_SNAPSHOT: return "no_snapshot";
+    case HOME_REFINE_FEW_POINTS: return "few_points";
+    case HOME_REFINE_NOT_CONVERGED: return "not_converged";
+    case HOME_REFINE_ILL_CONDITIONED: return "ill_conditioned";
+    case HOME_REFINE_OUTSIDE_TRUST: return "outside_trust";
+    case HOME_REFINE_NOT_LOWER: return "not_lower";
+    case HOME_REFINE_LOW_CORRELATION: return "low_correlation";
+    default: return "unknown";
+    }
+}
+
 int home_default_config(home_config *cfg, int width, int height)
 {
     if (!cfg) return HOME_E_NULL;
@@ -42,6 +72,8 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->hough_method = HOME_HOUGH_FAST;
     cfg->hough_downscale = 1;
     cfg->match_theta_window = 0;
+    cfg->max_model = HOME_MODEL_HOMOGRAPHY;
+    cfg->max_sigma_px = 1.0f;
 #ifndef HOME_NO_GETENV
     {
         const char *env = getenv("HOME_SIMD");
@@ -151,6 +183,9 @@ int home_validate_config(const home_config *cfg)
         return HOME_E_CONFIG;
     if (cfg->match_theta_window < 0 || cfg->match_theta_window > cfg->theta_bins)
         return HOME_E_CONFIG;
+    if (cfg->max_model < HOME_MODEL_IDENTITY || cfg->max_model > HOME_MODEL_HOMOGRAPHY)
+        return HOME_E_CONFIG;
+    if (!finite_in(cfg->max_sigma_px, 0.02f, 100.0f)) return HOME_E_CONFIG;
     return HOME_OK;
 }
 

@@ -214,6 +214,29 @@ typedef struct home__line_fit {
                           int *index);
 } home__line_fit;
 
+/* model.c: motion-model selection over a fit's Fisher information (see there) */
+#define HOME__SPACE_H 0          /* parameters: the homography's entries h0..h7 */
+#define HOME__SPACE_G 1          /* parameters: those of G = H^-T (the line fit's) */
+typedef struct home__model_problem {
+    int space;                   /* HOME__SPACE_H or _G */
+    double p[8];                 /* the estimate, normalised coordinates */
+    double info[64];             /* its Fisher information (inverse covariance) */
+    double penalty;              /* per parameter, in units of the information's chi-square */
+    int max_model;               /* enum home_model: the caller's cap */
+    int max_params;              /* models with more parameters are not determined by the data */
+    double scale, cx, cy;        /* pixel = scale * normalised + (cx, cy) */
+} home__model_problem;
+typedef struct home__model_choice {
+    int model;                   /* enum home_model */
+    double p[8];                 /* the model's estimate, same space */
+    double delta;                /* its misfit against the full estimate (chi-square units) */
+    double sigma_px;             /* predicted RMS corner error, px */
+} home__model_choice;
+/* 1 and the choice, or 0 when no model up to max_model is determined by the information. */
+int home__select_model(const home__model_problem *mp, home__model_choice *out);
+/* p (h0..h7 of a matrix with h8 = 1) -> the same of its inverse transpose; 0 when singular */
+int home__inverse_transpose8(const double *p, double *out);
+
 /* refine.c */
 void home__refine_defaults(home_config *cfg);
 int home__refine_validate(const home_config *cfg);

@@ -73,6 +73,75 @@ int home__homography_plausible(const double *h, int width, int height)
     return 1;
 }
 
+/* The line fit's residual scale never counts as below this many Hough bins: the extrema's
+ * subpixel positions carry their own error, which a handful of lines can understate. */
+#define LINE_SIGMA_FLOOR_BINS 0.1
+/* Predicted errors are the covariance's times this (calibrated on the evaluation's tuning set:
+ * several extrema of one edge are not independent observations). */
+#define LINE_SIGMA_SCALE 1.5
+
+/* Distinct lines among the inliers (their lines in A): several extrema of one edge are one
+ * observation of it, not many. Lines are told apart on a grid of 3 degrees by 3 Hough bins (at
+ * least 1/256 of the r range), counted in a bitmap. */
+#define DISTINCT_THETA_CELLS 60
+#define DISTINCT_R_CELLS 256
+static int distinct_lines(const home_context *ctx, const home__line_problem *lp, int n)
+{
+    uint32_t bits[DISTINCT_THETA_CELLS * DISTINCT_R_CELLS / 32];
+    const double r_range = ctx->r_bins * ctx->cfg.r_step * ctx->hough_scale;
+    double cell_r = 3.0 * ctx->cfg.r_step * ctx->hough_scale;
+    int i, count = 0;
+    if (cell_r * DISTINCT_R_CELLS < r_range) cell_r = r_range / DISTINCT_R_CELLS;
+    memset(bits, 0, sizeof bits);
+    for (i = 0; i < n; i++) {
+        const home__match *m = &lp->matches[lp->index[i]];
+        int t = (int)(m->theta_a * (DISTINCT_THETA_CELLS / HOME__PI));
+        int r = (int)floor((m->r_a + 0.5 * r_range) / cell_r);
+        unsigned cell;
+        t = t < 0 ? 0 : t >= DISTINCT_THETA_CELLS ? DISTINCT_THETA_CELLS - 1 : t;
+        r = r < 0 ? 0 : r >= DISTINCT_R_CELLS ? DISTINCT_R_CELLS - 1 : r;
+        cell = (unsigned)(t * DISTINCT_R_CELLS + r);
+        if (!(bits[cell / 32] >> (cell % 32) & 1u)) count++;
+        bits[cell / 32] |= 1u << (cell % 32);
+    }
+    return count;
+}
+
+/* Model selection over the final inliers (src/model.c): the LM's J^T J over the residual
+ * variance (two degrees of freedom per line: its angle and its offset) is the information of g.
+ * Writes the chosen model's g, result->model and result->sigma_px (infinite if none is
+ * determined). */
+static void choose_model(home_context *ctx, home__line_problem *lp, int n_in, double *g,
+                         home_result *result)
+{
+    home__model_problem mp;
+    home__model_choice choice;
+    double jtj[64], jte[8], cost, var;
+    int k, distinct;
+    lp->index = ctx->inlier_index;
+    lp->n = n_in;
+    cost = ctx->kernels->line_fit->normal(lp, g, jtj, jte);
+    var = 2 * n_in > 8 ? cost / (2 * n_in - 8) : cost;
+    if (!(var >= LINE_SIGMA_FLOOR_BINS * LINE_SIGMA_FLOOR_BINS))
+        var = LINE_SIGMA_FLOOR_BINS * LINE_SIGMA_FLOOR_BINS;
+    distinct = distinct_lines(ctx, lp, n_in);
+    /* n_in observations carry the information of `distinct` independent ones */
+    var *= LINE_SIGMA_SCALE * LINE_SIGMA_SCALE * n_in / (distinct > 0 ? distinct : 1);
+    mp.space = HOME__SPACE_G;
+    memcpy(mp.p, g, sizeof mp.p);
+    for (k = 0; k < 64; k++) mp.info[k] = jtj[k] / var;
+    mp.penalty = log(2.0 * (distinct > 0 ? distinct : 1));
+    mp.max_model = ctx->cfg.max_model;
+    mp.max_params = distinct; /* each line fixes two parameters: twice what a model needs */
+    mp.scale = lp->scale;
+    mp.cx = 0.5 * (ctx->cfg.width - 1);
+    mp.cy = 0.5 * (ctx->cfg.height - 1);
+    if (!home__select_model(&mp, &choice)) return;
+    memcpy(g, choice.p, sizeof choice.p);
+    result->model = choice.model;
+    result->sigma_px = choice.sigma_px;
+}
+
 int home__estimate_homography(home_context *ctx, int n_matches, home_result *result)
 {
     const home_config *cfg = &ctx->cfg;
@@ -108,6 +177,9 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     }
     n_in = ctx->kernels->line_fit->select_inliers(&lp, n_matches, g, cfg->threshold_final, ctx->inlier_index);
     result->inliers = n_in;
+    result->model = HOME_MODEL_HOMOGRAPHY;
+    result->sigma_px = INFINITY;
+    if (n_in >= 6) choose_model(ctx, &lp, n_in, g, result);
 
     /* G (lines, normalised coords) -> H_n = G^-T -> pixel coordinates: H = S^-1 H_n S with
      * S = [1/s 0 -cx/s; 0 1/s -cy/s; 0 0 1]. */
@@ -147,6 +219,10 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
      * 11-30 inliers with the video preset against 5-14 at full size): twice min_inliers there */
     if (n_in < cfg->min_inliers * (ctx->hough_scale > 1 ? 2 : 1)) {
         result->failure = HOME_FAIL_FEW_INLIERS;
+        return HOME_OK;
+    }
+    if (!(result->sigma_px <= cfg->max_sigma_px)) {
+        result->failure = HOME_FAIL_UNCERTAIN;
         return HOME_OK;
     }
     result->failure = HOME_FAIL_NONE;

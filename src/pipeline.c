@@ -175,6 +175,8 @@ static void reset_result(home_result *r)
 {
     memset(r, 0, sizeof *r);
     r->H[0] = r->H[4] = r->H[8] = 1.0;
+    r->model = HOME_MODEL_HOMOGRAPHY;
+    r->sigma_px = INFINITY;
 }
 
 /* matching + homography; the extraction timings are added by the callers */

@@ -13,12 +13,18 @@
 #define STAB_BISECT_STEPS 30
 #define STAB_THETA_BINS 88                /* HOME's automatic theta bins for video registration */
 #define STAB_REFINE_POINTS 1024           /* HOME's refinement template points at full size */
+/* A registration's predicted error (sigma_px, full-size px) weighs its motion: the measurement
+ * noise of its frame is r (1 + (sigma / STAB_SIGMA_REF_PX)^2), so a coarse or uncertain motion
+ * pulls the path less; beyond STAB_MAX_SIGMA_PX the frame holds the path. */
+#define STAB_SIGMA_REF_PX 0.5
+#define STAB_MAX_SIGMA_PX 4.0
 
 /* One frame of path history. Path components are normalised to pixels (angle and log scale
  * times the half diagonal) so that one filter covariance serves all four of them. */
 typedef struct stab_slot {
     long frame;
     int status;
+    double weight;                /* measurement noise factor (1: an exact motion) */
     home_stab_sim raw;            /* camera path: frame 0 -> this frame */
     double xf[4][2], xp[4][2];    /* filtered / predicted (position, velocity) per component */
     double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
@@ -111,6 +117,11 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
      * 0.003 dB, also with 10 px / 1 degree shake; 15.7 -> 13.0 M instructions per 640x360
      * frame (2048: 13.9 M; 512: textureless jitter +0.007 px) */
     h->refine_points = STAB_REFINE_POINTS;
+    /* the path is a similarity: ask for one, so scenes of a few edges, which leave a
+     * homography undetermined, still register */
+    h->max_model = HOME_MODEL_SIMILARITY;
+    /* coarse estimates come back with their (larger) sigma, weighed by the smoother */
+    h->max_sigma_px = (float)(STAB_MAX_SIGMA_PX / f);
     h->refine_finest_level = cfg->refine ? cfg->refine_finest_level : 0;
     if (cfg->hough_downscale) h->hough_downscale = cfg->hough_downscale;
     h->simd = cfg->simd;
@@ -376,7 +387,7 @@ static void kalman_step(const home_stab *st, const stab_slot *prev, stab_slot *c
     cur->pp[0] = prev->pf[0] + 2.0 * prev->pf[1] + prev->pf[2] + st->q / 3.0;
     cur->pp[1] = prev->pf[1] + prev->pf[2] + st->q / 2.0;
     cur->pp[2] = prev->pf[2] + st->q;
-    sv = cur->pp[0] + st->r;
+    sv = cur->pp[0] + st->r * cur->weight;
     k0 = cur->pp[0] / sv;
     k1 = cur->pp[1] / sv;
     for (c = 0; c < 4; c++) {
@@ -440,6 +451,7 @@ static void refilter_mirrored_start(const home_stab *st, long last)
     double trend[4], z[4];
     long i;
     if (k <= 0) return;
+    v[0].weight = v[1].weight = 1.0;
     path_trend(st, 0, k, trend);
     for (i = -k; i <= last; i++) {
         stab_slot *cur = i < 0 ? &v[i & 1] : slot_of(st, i);
@@ -463,6 +475,7 @@ static void append_mirrored_end(home_stab *st, long last)
         mirrored_measurement(st, last + i, last, trend, z);
         cur->frame = last + i;
         cur->status = HOME_STAB_MOTION_OK;
+        cur->weight = 1.0;
         kalman_step(st, slot_of(st, last + i - 1), cur, z);
     }
     st->tail = 1;
@@ -569,6 +582,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     ptrdiff_t stride;
     home_features *swap;
     home_stab_sim motion = {0, 0, 0, 0};
+    double weight = 1.0;
     stab_slot *slot;
     double t0 = 0, z[4];
     long n;
@@ -595,8 +609,10 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
             if (res >= 0.0 && res <= st->cfg.max_residual &&
                 hypot(s.tx, s.ty) <= st->cfg.max_shift * st->cfg.width &&
                 fabs(s.angle) <= st->cfg.max_rotation && fabs(s.log_scale) <= st->cfg.max_zoom) {
+                const double sigma = out->reg.sigma_px * st->cfg.downscale / STAB_SIGMA_REF_PX;
                 out->newest_status = HOME_STAB_MOTION_OK;
                 motion = s;
+                weight = 1.0 + sigma * sigma;
             }
         }
     }
@@ -608,6 +624,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     slot = slot_of(st, n);
     slot->frame = n;
     slot->status = out->newest_status;
+    slot->weight = weight;
     if (n == 0) {
         memset(&slot->raw, 0, sizeof slot->raw);
         path_components(st, &slot->raw, z);

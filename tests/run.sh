@@ -55,6 +55,9 @@ assert list(j)[:5] == ["ok", "H", "keypoints", "matches", "inliers"], list(j)
 assert j["ok"] is True and len(j["H"]) == 9 and abs(j["H"][8] - 1) < 1e-12
 assert len(j["keypoints"]) == 2 and j["inliers"] >= 20 and j["matches"] >= j["inliers"]
 assert set(j["ms"]) >= {"hough", "detect", "describe", "match", "homography", "total"}
+assert j["model"] in ("identity", "translation", "similarity", "affine", "homography"), j["model"]
+assert j["failure"] == "none" and j["refine_status"] == "accepted", j
+assert 0 < j["sigma_px"] <= 1.0, j["sigma_px"]
 def ap(h, x, y):
     w = h[6] * x + h[7] * y + h[8]
     return (h[0] * x + h[1] * y + h[2]) / w, (h[3] * x + h[4] * y + h[5]) / w
@@ -63,6 +66,7 @@ for x, y in ((0, 0), (639, 0), (0, 359), (639, 359)):
     a, b = ap(j["H"], x, y), ap(truth["H"], x, y)
     err += ((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2) ** 0.5 / 4
 assert err < 1.0, "corner error %.3f" % err
+assert err < 3 * j["sigma_px"] + 0.05, "corner error %.3f against sigma %.3f" % (err, j["sigma_px"])
 PY
 then ok cli_json_contract; else fail cli_json_contract "$(head -c 300 "$tmp/out.json" "$tmp/err")"; fi
 

@@ -151,12 +151,17 @@ static void check_result(const home_config *cfg, const home_result *res)
         double det = h[0] * (h[4] * h[8] - h[5] * h[7]) - h[1] * (h[3] * h[8] - h[5] * h[6]) +
                      h[2] * (h[3] * h[7] - h[4] * h[6]);
         FZ_CHECK(h[8] == 1.0 && det > 0.0);
-        FZ_CHECK(res->failure == HOME_FAIL_NONE || res->failure == HOME_FAIL_FEW_INLIERS);
+        FZ_CHECK(res->failure == HOME_FAIL_NONE);
+        /* ok means a determined model within the cap and a predicted error within the bound */
+        FZ_CHECK(res->sigma_px >= 0.0 && res->sigma_px <= cfg->max_sigma_px);
+        FZ_CHECK(res->model >= HOME_MODEL_IDENTITY && res->model <= cfg->max_model);
         if (res->inliers < cfg->min_inliers) /* the refinement's rescue (home.h's failure rule) */
-            FZ_CHECK(res->refined && res->inliers >= 8 && res->refine_zncc >= 0.9);
+            FZ_CHECK(res->refined && res->refine_zncc >= 0.9);
     } else {
-        FZ_CHECK(res->failure >= HOME_FAIL_FEW_MATCHES && res->failure <= HOME_FAIL_DEGENERATE);
+        FZ_CHECK(res->failure >= HOME_FAIL_FEW_MATCHES && res->failure <= HOME_FAIL_INCONSISTENT);
     }
+    FZ_CHECK(res->model >= HOME_MODEL_IDENTITY && res->model <= HOME_MODEL_HOMOGRAPHY);
+    FZ_CHECK(!(res->sigma_px < 0.0)); /* NaN never: infinite when undetermined */
 }
 
 static void fuzz_config(fz_reader *r, home_config *cfg)
@@ -185,7 +190,12 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
         case 16: cfg->match_theta_window = raw % 4096; break;
         case 17: cfg->refine_points = raw % 8192; break;
         case 18: cfg->refine_finest_level = raw % 4; break;
-        default: cfg->width = raw; break;
+        default:
+            /* a third each: the model cap (-1..5: 0..4 valid), the sigma bound, the width */
+            if (raw % 3 == 0) cfg->max_model = (int)((uint32_t)raw / 3 % 7) - 1;
+            else if (raw % 3 == 1 || raw % 3 == -1) cfg->max_sigma_px = f;
+            else cfg->width = raw;
+            break;
         }
     }
 }

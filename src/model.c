@@ -1,0 +1,239 @@
+/* Motion-model selection and predicted accuracy from a fit's Fisher information.
+ *
+ * A fit (the line fit or the photometric refinement) ends at an estimate p of 8 parameters with
+ * its Fisher information F (the Gauss-Newton J^T J over the residual variance, so
+ * cost(p') - cost(p) ~ (p' - p)^T F (p' - p) in units of the noise). Every simpler model is a
+ * linear subspace p = o + B q of the same parameters, so its best estimate under that quadratic
+ * is a k x k least-squares projection, its misfit Delta = (o + B q - p)^T F (o + B q - p), and
+ * its covariance (B^T F B)^-1. The model chosen minimises Delta + penalty * k (BIC: the penalty
+ * is ln of the number of observations), among the models the data determine (B^T F B positive
+ * definite, and no more parameters than the caller says the data can fix); F need not be
+ * invertible, so a scene whose lines leave a homography undetermined still gets the similarity
+ * or translation they do fix.
+ *
+ * Spaces: the refinement's p are the homography's entries h0..h7 (h8 = 1) in normalised
+ * coordinates; the line fit's are G = H^-T's. A model keeps the same form in both, except that the
+ * translation and the perspective entries trade places: H = [A t; 0 1] has G = [A^-T 0; -(A^-1 t)^T
+ * 1]. Similarity: A = [a -b; b a] in both (A^-T = A / (a^2 + b^2)). */
+#include "home_internal.h"
+#include <math.h>
+#include <string.h>
+
+/* Solve a x = b (k x k SPD, row stride 8) by padding to the 8x8 solver; a is overwritten. */
+static int solve_spd(double *a, double *b, int k)
+{
+    int i;
+    for (i = k; i < 8; i++) {
+        memset(a + i * 8, 0, 8 * sizeof *a);
+        a[i * 8 + i] = 1.0;
+        b[i] = 0.0;
+    }
+    for (i = 0; i < k; i++) memset(a + i * 8 + k, 0, (size_t)(8 - k) * sizeof *a);
+    return home__solve_spd8(a, b);
+}
+
+/* The model's subspace p = o + B q: basis columns (8 entries each) and offset. */
+static int model_basis(int space, int model, double *o, double basis[8][8])
+{
+    const int tx = space == HOME__SPACE_G ? 6 : 2, ty = space == HOME__SPACE_G ? 7 : 5;
+    const int px = space == HOME__SPACE_G ? 2 : 6, py = space == HOME__SPACE_G ? 5 : 7;
+    int k = 0, i;
+    memset(basis, 0, 64 * sizeof basis[0][0]);
+    memset(o, 0, 8 * sizeof *o);
+    switch (model) {
+    case HOME_MODEL_IDENTITY:
+        o[0] = o[4] = 1.0;
+        break;
+    case HOME_MODEL_TRANSLATION:
+        o[0] = o[4] = 1.0;
+        basis[k++][tx] = 1.0;
+        basis[k++][ty] = 1.0;
+        break;
+    case HOME_MODEL_SIMILARITY:
+        basis[k][0] = basis[k][4] = 1.0;
+        k++;
+        basis[k][1] = -1.0;
+        basis[k][3] = 1.0;
+        k++;
+        basis[k++][tx] = 1.0;
+        basis[k++][ty] = 1.0;
+        break;
+    case HOME_MODEL_AFFINE:
+        for (i = 0; i < 8; i++)
+            if (i != px && i != py) basis[k++][i] = 1.0;
+        break;
+    default:
+        for (i = 0; i < 8; i++) basis[k++][i] = 1.0;
+        break;
+    }
+    return k;
+}
+
+/* d(corner)/dp of the image corners (px) for a pixel-space homography h (h8 = 1) whose
+ * parameters p are its normalised entries (pixel = scale * u + centre): row 2c + axis. */
+static void corner_jacobian(const double *hn, double scale, double cx, double cy, double jac[8][8])
+{
+    const double hu = cx / scale, hv = cy / scale;
+    int c;
+    for (c = 0; c < 4; c++) {
+        const double u = (c & 1) ? hu : -hu, v = (c & 2) ? hv : -hv;
+        const double w = hn[6] * u + hn[7] * v + 1.0;
+        const double x = (hn[0] * u + hn[1] * v + hn[2]) / w;
+        const double y = (hn[3] * u + hn[4] * v + hn[5]) / w;
+        double *jx = jac[2 * c], *jy = jac[2 * c + 1];
+        memset(jx, 0, 8 * sizeof *jx);
+        memset(jy, 0, 8 * sizeof *jy);
+        jx[0] = u / w * scale; jx[1] = v / w * scale; jx[2] = 1.0 / w * scale;
+        jx[6] = -x * u / w * scale; jx[7] = -x * v / w * scale;
+        jy[3] = u / w * scale; jy[4] = v / w * scale; jy[5] = 1.0 / w * scale;
+        jy[6] = -y * u / w * scale; jy[7] = -y * v / w * scale;
+    }
+}
+
+/* G = H^-T normalised to g8 = 1 (the same map takes G back to H); 0 when singular. */
+int home__inverse_transpose8(const double *p, double *out)
+{
+    const double m[9] = {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], 1.0};
+    double c[9], d;
+    int k;
+    c[0] = m[4] * m[8] - m[5] * m[7];
+    c[1] = -(m[3] * m[8] - m[5] * m[6]);
+    c[2] = m[3] * m[7] - m[4] * m[6];
+    c[3] = -(m[1] * m[8] - m[2] * m[7]);
+    c[4] = m[0] * m[8] - m[2] * m[6];
+    c[5] = -(m[0] * m[7] - m[1] * m[6]);
+    c[6] = m[1] * m[5] - m[2] * m[4];
+    c[7] = -(m[0] * m[5] - m[2] * m[3]);
+    c[8] = m[0] * m[4] - m[1] * m[3];
+    d = c[8];
+    if (!(fabs(d) > 1e-12) || !isfinite(d)) return 0;
+    for (k = 0; k < 8; k++) out[k] = c[k] / d;
+    return 1;
+}
+
+/* The normalised homography of parameters p (h0..h7, h8 = 1). */
+static int to_h(int space, const double *p, double *hn)
+{
+    if (space == HOME__SPACE_H) {
+        memcpy(hn, p, 8 * sizeof *hn);
+        return 1;
+    }
+    return home__inverse_transpose8(p, hn);
+}
+
+int home__select_model(const home__model_problem *mp, home__model_choice *out)
+{
+    double basis[8][8], o[8], dh_dp[8][8], cj[8][8], hn[8];
+    int model, i, j, c, best = -1;
+    double best_score = INFINITY;
+    home__model_choice trial;
+
+    out->model = -1;
+    out->sigma_px = INFINITY;
+    for (model = HOME_MODEL_IDENTITY; model <= mp->max_model; model++) {
+        double n_mat[64] = {0}, rhs[8] = {0}, q[8], diff[8], fd[8], delta = 0.0, var = 0.0, score;
+        const int k = model_basis(mp->space, model, o, basis);
+        if (k > mp->max_params) break;
+        /* q = (B^T F B)^-1 B^T F (p - o) */
+        for (i = 0; i < 8; i++) {
+            double s = 0.0;
+            for (j = 0; j < 8; j++) s += mp->info[i * 8 + j] * (mp->p[j] - o[j]);
+            fd[i] = s;
+        }
+        for (i = 0; i < k; i++) {
+            double s = 0.0;
+            for (j = 0; j < 8; j++) s += basis[i][j] * fd[j];
+            rhs[i] = s;
+            for (j = 0; j < k; j++) {
+                double t = 0.0;
+                int a, b;
+                for (a = 0; a < 8; a++) {
+                    if (basis[i][a] == 0.0) continue;
+                    for (b = 0; b < 8; b++) t += basis[i][a] * mp->info[a * 8 + b] * basis[j][b];
+                }
+                n_mat[i * 8 + j] = t;
+            }
+        }
+        {
+            double a_copy[64];
+            memcpy(a_copy, n_mat, sizeof a_copy);
+            memcpy(q, rhs, sizeof q);
+            if (k > 0 && !solve_spd(a_copy, q, k)) continue; /* not determined by the data */
+        }
+        memcpy(trial.p, o, sizeof o);
+        for (i = 0; i < k; i++)
+            for (j = 0; j < 8; j++) trial.p[j] += q[i] * basis[i][j];
+        for (i = 0; i < 8; i++) diff[i] = trial.p[i] - mp->p[i];
+        for (i = 0; i < 8; i++)
+            for (j = 0; j < 8; j++) delta += diff[i] * mp->info[i * 8 + j] * diff[j];
+        if (!isfinite(delta)) continue;
+        score = delta + mp->penalty * k;
+        /* predicted corner covariance of the model's estimate: J_c B (B^T F B)^-1 B^T J_c^T */
+        if (!to_h(mp->space, trial.p, hn)) continue;
+        corner_jacobian(hn, mp->scale, mp->cx, mp->cy, cj);
+        if (mp->space == HOME__SPACE_G) {
+            /* d corner / d g = d corner / d h  d h / d g, the latter by central differences */
+            double p1[8], p2[8], h1[8], h2[8];
+            for (j = 0; j < 8; j++) {
+                const double eps = 1e-6;
+                memcpy(p1, trial.p, sizeof p1);
+                memcpy(p2, trial.p, sizeof p2);
+                p1[j] += eps;
+                p2[j] -= eps;
+                if (!home__inverse_transpose8(p1, h1) || !home__inverse_transpose8(p2, h2)) break;
+                for (i = 0; i < 8; i++) dh_dp[i][j] = (h1[i] - h2[i]) / (2 * eps);
+            }
+            if (j < 8) continue;
+            for (c = 0; c < 8; c++) {
+                double row[8];
+                for (j = 0; j < 8; j++) {
+                    double s = 0.0;
+                    for (i = 0; i < 8; i++) s += cj[c][i] * dh_dp[i][j];
+                    row[j] = s;
+                }
+                memcpy(cj[c], row, sizeof row);
+            }
+        }
+        for (c = 0; c < 8 && k > 0; c++) {
+            double jq[8], z[8], a_copy[64], v = 0.0;
+            for (i = 0; i < k; i++) {
+                double s = 0.0;
+                for (j = 0; j < 8; j++) s += basis[i][j] * cj[c][j];
+                jq[i] = s;
+            }
+            memcpy(a_copy, n_mat, sizeof a_copy);
+            memcpy(z, jq, sizeof z);
+            if (!solve_spd(a_copy, z, k)) { var = INFINITY; break; }
+            for (i = 0; i < k; i++) v += jq[i] * z[i];
+            var += v;
+        }
+        trial.model = model;
+        trial.delta = delta;
+        trial.sigma_px = sqrt(var / 4.0); /* RMS over the four corners of the 2-D error */
+        if (!isfinite(trial.sigma_px)) continue;
+        if (score < best_score) {
+            best_score = score;
+            best = model;
+            *out = trial;
+        }
+    }
+    /* the chosen model must explain the data no worse than an exact homography would, at its
+     * cost in parameters (matters when the homography is undetermined); a cap below the
+     * homography asks for the best such model whatever its misfit */
+    if (best >= 0 && best < HOME_MODEL_HOMOGRAPHY && mp->max_model == HOME_MODEL_HOMOGRAPHY &&
+        !(out->delta <= mp->penalty * (8 - model_basis(mp->space, best, o, basis))))
+        return 0;
+    return best >= 0;
+}
+
+const char *home_model_name(int model)
+{
+    switch (model) {
+    case HOME_MODEL_IDENTITY: return "identity";
+    case HOME_MODEL_TRANSLATION: return "translation";
+    case HOME_MODEL_SIMILARITY: return "similarity";
+    case HOME_MODEL_AFFINE: return "affine";
+    case HOME_MODEL_HOMOGRAPHY: return "homography";
+    default: return "unknown";
+    }
+}
