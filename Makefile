@@ -28,7 +28,7 @@ LIB_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 #   "N passed, N failed" last), LIB_OBJ += ... (extra library objects, e.g. port/ kernels).
 LIB := $(BUILD)/lib/libhome.a
 SUPPORT_OBJ := $(BUILD)/obj/examples/pgm.o $(BUILD)/obj/examples/synth.o
-TEST_OBJ := $(patsubst %,$(BUILD)/obj/tests/%.o,test_main test_runner test_stages test_pipeline test_kernels)
+TEST_OBJ := $(patsubst %,$(BUILD)/obj/tests/%.o,test_main test_runner test_stages test_pipeline test_kernels test_trust)
 BINS := $(BUILD)/bin/home-register $(BUILD)/bin/home-make-pair $(BUILD)/bin/home-tests
 TEST_BINS := $(BUILD)/bin/home-tests
 

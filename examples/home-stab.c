@@ -42,7 +42,9 @@ static void usage(FILE *f)
             "  --side-by-side    write original | stabilised, twice as wide\n"
             "  --csv FILE        per frame: raw and smoothed camera path (tx, ty px, angle rad,\n"
             "                    log scale), share of the correction applied, and the warp\n"
-            "                    (output pixel -> input pixel, affine, w00..w12)\n"
+            "                    (output pixel -> input pixel, affine, w00..w12), and the frame's\n"
+            "                    registration: its motion model and predicted error sigma_px\n"
+            "                    (px of the registration image; an uncertain motion pulls less)\n"
             "  --plot FILE.png   plot of the raw and smoothed path\n"
             "  --threads N       1 (default): register, warp and write in turn; 2: warp and write\n"
             "                    on a second thread, overlapping the next registrations (same output)\n"
@@ -63,6 +65,12 @@ static int number(const char *s, double lo, double hi, double *out)
 /* Outputs waiting for the writer thread; a few suffice: registration is the slower half. */
 #define WRITE_QUEUE 4
 
+/* What the CSV reports of a frame's registration (the frame is written lookahead frames later). */
+typedef struct reg_info {
+    int inliers, model;           /* model: enum home_model */
+    double sigma_px;              /* predicted RMS corner error, registration px (inf: none) */
+} reg_info;
+
 typedef struct app {
     y4m_info info;
     FILE *out, *csv;
@@ -71,7 +79,7 @@ typedef struct app {
     uint8_t **ring;               /* lookahead + 1 input frames, + WRITE_QUEUE with a writer thread */
     int ring_len;
     uint8_t *result, *wide;
-    int *inliers;                 /* per ring slot: the frame's registration inliers */
+    reg_info *reg;                /* per ring slot: the frame's registration */
     stab_path_plot plot;
     long written;                 /* frames written (by the writer thread when there is one) */
     double ms_warp;               /* time in write_output(): warp, side by side, write */
@@ -129,12 +137,15 @@ static int write_output(app *ap, const home_stab_output *o)
         fprintf(stderr, "home-stab: write error\n");
         return -1;
     }
-    if (ap->csv)
-        fprintf(ap->csv, "%ld,%s,%d,%.4f,%.4f,%.6f,%.6f,%.4f,%.4f,%.6f,%.6f,%.4f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-                o->frame, status_name(o->motion_status), ap->inliers[o->frame % ap->ring_len], o->raw.tx,
+    if (ap->csv) {
+        const reg_info *reg = &ap->reg[o->frame % ap->ring_len];
+        fprintf(ap->csv, "%ld,%s,%d,%.4f,%.4f,%.6f,%.6f,%.4f,%.4f,%.6f,%.6f,%.4f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s,%.4g\n",
+                o->frame, status_name(o->motion_status), reg->inliers, o->raw.tx,
                 o->raw.ty, o->raw.angle, o->raw.log_scale, o->smooth.tx, o->smooth.ty,
                 o->smooth.angle, o->smooth.log_scale, o->correction_used, o->warp[0], o->warp[1],
-                o->warp[2], o->warp[3], o->warp[4], o->warp[5]);
+                o->warp[2], o->warp[3], o->warp[4], o->warp[5],
+                o->frame ? home_model_name(reg->model) : "none", o->frame ? reg->sigma_px : 0.0);
+    }
     stab_plot_add(&ap->plot, &o->raw, &o->smooth);
     ap->ms_warp += now_ms(NULL) - t0;
     return 0;
@@ -277,10 +288,10 @@ int main(int argc, char **argv)
      * most WRITE_QUEUE unwritten ones: its slot's previous frame, n - ring_len, is written */
     ap.ring_len = cfg.lookahead + 1 + (threads > 1 ? WRITE_QUEUE : 0);
     ap.ring = calloc((size_t)ap.ring_len, sizeof *ap.ring);
-    ap.inliers = calloc((size_t)ap.ring_len, sizeof *ap.inliers);
+    ap.reg = calloc((size_t)ap.ring_len, sizeof *ap.reg);
     ap.result = malloc(ap.frame_bytes);
     ap.wide = malloc(2 * ap.frame_bytes);
-    if (!arena || !ap.ring || !ap.inliers || !ap.result || !ap.wide) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
+    if (!arena || !ap.ring || !ap.reg || !ap.result || !ap.wide) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
     for (i = 0; i < ap.ring_len; i++)
         if (!(ap.ring[i] = malloc(ap.frame_bytes))) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
     status = home_stab_init(&stab, &cfg, arena, need, NULL);
@@ -292,7 +303,8 @@ int main(int argc, char **argv)
     if (csv_path) {
         if (!(ap.csv = fopen(csv_path, "w"))) { fprintf(stderr, "home-stab: cannot write %s\n", csv_path); return 2; }
         fprintf(ap.csv, "frame,status,inliers,raw_tx,raw_ty,raw_angle,raw_log_scale,smooth_tx,"
-                        "smooth_ty,smooth_angle,smooth_log_scale,correction_used,w00,w01,w02,w10,w11,w12\n");
+                        "smooth_ty,smooth_angle,smooth_log_scale,correction_used,w00,w01,w02,w10,w11,w12,"
+                        "model,sigma_px\n");
     }
     y4m_write_header(ap.out, &ap.info, ap.side_by_side ? 2 * ap.info.width : ap.info.width);
     if (threads > 1) {
@@ -319,7 +331,9 @@ int main(int argc, char **argv)
         y4m_image(&ap.info, ap.info.width, buf, &im);
         status = home_stab_push(stab, &im, &o);
         if (status != HOME_OK) { fprintf(stderr, "home-stab: %s\n", home_strerror(status)); rc = 2; break; }
-        ap.inliers[frames % ap.ring_len] = o.reg.inliers;
+        ap.reg[frames % ap.ring_len].inliers = o.reg.inliers;
+        ap.reg[frames % ap.ring_len].model = o.reg.model;
+        ap.reg[frames % ap.ring_len].sigma_px = o.reg.sigma_px;
         failed += o.newest_status == HOME_STAB_MOTION_FAILED || o.newest_status == HOME_STAB_MOTION_IMPLAUSIBLE;
         ms_reg += o.ms_register;
         frames++;
@@ -353,7 +367,7 @@ int main(int argc, char **argv)
     if (ap.out != stdout) fclose(ap.out);
     if (in != stdin) fclose(in);
     for (i = 0; i < ap.ring_len; i++) free(ap.ring[i]);
-    free(ap.ring); free(ap.inliers); free(ap.result); free(ap.wide); free(arena);
+    free(ap.ring); free(ap.reg); free(ap.result); free(ap.wide); free(arena);
     stab_plot_free(&ap.plot);
     return rc;
 }

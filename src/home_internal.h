@@ -234,6 +234,14 @@ typedef struct home__model_choice {
 } home__model_choice;
 /* 1 and the choice, or 0 when no model up to max_model is determined by the information. */
 int home__select_model(const home__model_problem *mp, home__model_choice *out);
+/* The model's parameters as an affine subspace p = o + B q of the 8 (basis: k columns of 8,
+ * the same form in both spaces but for the translation and perspective entries); returns k. */
+int home__model_basis(int space, int model, double *o, double basis[8][8]);
+/* Normal equations of p projected onto q (B^T A B, B^T g), padded to 8x8 with the identity. */
+void home__project_normal(const double basis[8][8], int k, const double *jtj, const double *jte,
+                          double *jtj_q, double *jte_q);
+/* a x = b for a k x k SPD a (row stride 8; overwritten), k <= 8; 0 when not positive definite */
+int home__solve_spd(double *a, double *b, int k);
 /* p (h0..h7 of a matrix with h8 = 1) -> the same of its inverse transpose; 0 when singular */
 int home__inverse_transpose8(const double *p, double *out);
 

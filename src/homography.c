@@ -80,6 +80,35 @@ int home__homography_plausible(const double *h, int width, int height)
  * several extrema of one edge are not independent observations). */
 #define LINE_SIGMA_SCALE 1.5
 
+/* The line fit restricted to a model's parameters g = o + B q (src/model.c). */
+typedef struct subspace_problem {
+    const home__line_problem *lp;
+    home__normal_fn fn;
+    double o[8], basis[8][8];
+    int k;
+} subspace_problem;
+
+static void subspace_point(const subspace_problem *sp, const double *q, double *g)
+{
+    int i, j;
+    memcpy(g, sp->o, 8 * sizeof *g);
+    for (i = 0; i < sp->k; i++)
+        for (j = 0; j < 8; j++) g[j] += q[i] * sp->basis[i][j];
+}
+
+/* home__lm_solve's problem in q: the lines' normal equations projected (padded coordinates of
+ * q beyond k get the identity and no gradient, so they never move) */
+static double subspace_normal(const void *user, const double *q, double *jtj, double *jte)
+{
+    const subspace_problem *sp = (const subspace_problem *)user;
+    double g[8], a[64], b[8], cost;
+    subspace_point(sp, q, g);
+    if (!jtj) return sp->fn(sp->lp, g, NULL, NULL);
+    cost = sp->fn(sp->lp, g, a, b);
+    home__project_normal(sp->basis, sp->k, a, b, jtj, jte);
+    return cost;
+}
+
 /* Distinct lines among the inliers (their lines in A): several extrema of one edge are one
  * observation of it, not many. Lines are told apart on a grid of 3 degrees by 3 Hough bins (at
  * least 1/256 of the r range), counted in a bitmap. */
@@ -148,8 +177,9 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     const double cx = 0.5 * (cfg->width - 1), cy = 0.5 * (cfg->height - 1);
     home__line_problem lp;
     double g[8] = {1, 0, 0, 0, 1, 0, 0, 0};
-    double gm[9], hn[9], h[9], t;
+    double gm[9], hn[9], h[9], t, q[8];
     int n_in = 0, k, level;
+    subspace_problem sub;
 
     lp.matches = ctx->matches;
     lp.index = ctx->inlier_index;
@@ -162,16 +192,36 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
     result->inliers = 0;
     if (n_matches < 8) { result->failure = HOME_FAIL_FEW_MATCHES; return HOME_OK; }
 
+    /* below a homography, the whole fit runs in the model's parameters: a few lines that leave
+     * a homography undetermined still fix a similarity, and no undetermined direction drifts */
+    sub.lp = &lp;
+    sub.fn = ctx->kernels->line_fit->normal;
+    sub.k = home__model_basis(HOME__SPACE_G, cfg->max_model, sub.o, sub.basis);
+    for (k = 0; k < 8; k++) {
+        double num = 0.0, den = 0.0;
+        int j;
+        for (j = 0; j < 8 && k < sub.k; j++) {
+            num += sub.basis[k][j] * (g[j] - sub.o[j]);
+            den += sub.basis[k][j] * sub.basis[k][j];
+        }
+        q[k] = den > 0.0 ? num / den : 0.0;
+    }
     t = cfg->threshold_start;
     for (level = 0; level < HOME_MAX_THRESHOLD_LEVELS; level++) {
+        const int iters = t <= cfg->threshold_final ? HOME_LM_MAX_ITERS : HOME_LM_COARSE_ITERS;
+        int solved;
         n_in = ctx->kernels->line_fit->select_inliers(&lp, n_matches, g, t, ctx->inlier_index);
         if (n_in < 6) break;               /* too few lines left to constrain 8 parameters */
         /* coarse levels only move the estimate into the next, narrower gate: a few iterations
          * do; the final level converges fully */
         lp.n = n_in;
-        if (!home__lm_solve(g, ctx->kernels->line_fit->normal, &lp,
-                            t <= cfg->threshold_final ? HOME_LM_MAX_ITERS : HOME_LM_COARSE_ITERS))
-            break;
+        if (cfg->max_model == HOME_MODEL_HOMOGRAPHY) {
+            solved = home__lm_solve(g, ctx->kernels->line_fit->normal, &lp, iters);
+        } else {
+            solved = sub.k > 0 && home__lm_solve(q, subspace_normal, &sub, iters);
+            subspace_point(&sub, q, g);
+        }
+        if (!solved) break;
         if (t <= cfg->threshold_final) break;
         t = t * 0.5 > cfg->threshold_final ? t * 0.5 : cfg->threshold_final;
     }

@@ -20,7 +20,7 @@
 #include <string.h>
 
 /* Solve a x = b (k x k SPD, row stride 8) by padding to the 8x8 solver; a is overwritten. */
-static int solve_spd(double *a, double *b, int k)
+int home__solve_spd(double *a, double *b, int k)
 {
     int i;
     for (i = k; i < 8; i++) {
@@ -32,8 +32,8 @@ static int solve_spd(double *a, double *b, int k)
     return home__solve_spd8(a, b);
 }
 
-/* The model's subspace p = o + B q: basis columns (8 entries each) and offset. */
-static int model_basis(int space, int model, double *o, double basis[8][8])
+/* The model's subspace p = o + B q: basis columns (8 entries each) and offset; returns k. */
+int home__model_basis(int space, int model, double *o, double basis[8][8])
 {
     const int tx = space == HOME__SPACE_G ? 6 : 2, ty = space == HOME__SPACE_G ? 7 : 5;
     const int px = space == HOME__SPACE_G ? 2 : 6, py = space == HOME__SPACE_G ? 5 : 7;
@@ -90,6 +90,22 @@ static void corner_jacobian(const double *hn, double scale, double cx, double cy
     }
 }
 
+/* RMS over the four image corners of the distance between two normalised homographies, px. */
+static double corner_rms_distance(const double *ha, const double *hb, const home__model_problem *mp)
+{
+    const double hu = mp->cx / mp->scale, hv = mp->cy / mp->scale;
+    double sum = 0.0;
+    int c;
+    for (c = 0; c < 4; c++) {
+        const double u = (c & 1) ? hu : -hu, v = (c & 2) ? hv : -hv;
+        const double wa = ha[6] * u + ha[7] * v + 1.0, wb = hb[6] * u + hb[7] * v + 1.0;
+        const double dx = (ha[0] * u + ha[1] * v + ha[2]) / wa - (hb[0] * u + hb[1] * v + hb[2]) / wb;
+        const double dy = (ha[3] * u + ha[4] * v + ha[5]) / wa - (hb[3] * u + hb[4] * v + hb[5]) / wb;
+        sum += dx * dx + dy * dy;
+    }
+    return mp->scale * sqrt(sum / 4.0);
+}
+
 /* G = H^-T normalised to g8 = 1 (the same map takes G back to H); 0 when singular. */
 int home__inverse_transpose8(const double *p, double *out)
 {
@@ -126,13 +142,13 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
     double basis[8][8], o[8], dh_dp[8][8], cj[8][8], hn[8];
     int model, i, j, c, best = -1;
     double best_score = INFINITY;
-    home__model_choice trial;
+    home__model_choice trial, general;
 
     out->model = -1;
     out->sigma_px = INFINITY;
     for (model = HOME_MODEL_IDENTITY; model <= mp->max_model; model++) {
         double n_mat[64] = {0}, rhs[8] = {0}, q[8], diff[8], fd[8], delta = 0.0, var = 0.0, score;
-        const int k = model_basis(mp->space, model, o, basis);
+        const int k = home__model_basis(mp->space, model, o, basis);
         if (k > mp->max_params) break;
         /* q = (B^T F B)^-1 B^T F (p - o) */
         for (i = 0; i < 8; i++) {
@@ -158,7 +174,7 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
             double a_copy[64];
             memcpy(a_copy, n_mat, sizeof a_copy);
             memcpy(q, rhs, sizeof q);
-            if (k > 0 && !solve_spd(a_copy, q, k)) continue; /* not determined by the data */
+            if (k > 0 && !home__solve_spd(a_copy, q, k)) continue; /* not determined by the data */
         }
         memcpy(trial.p, o, sizeof o);
         for (i = 0; i < k; i++)
@@ -203,7 +219,7 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
             }
             memcpy(a_copy, n_mat, sizeof a_copy);
             memcpy(z, jq, sizeof z);
-            if (!solve_spd(a_copy, z, k)) { var = INFINITY; break; }
+            if (!home__solve_spd(a_copy, z, k)) { var = INFINITY; break; }
             for (i = 0; i < k; i++) v += jq[i] * z[i];
             var += v;
         }
@@ -211,17 +227,27 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
         trial.delta = delta;
         trial.sigma_px = sqrt(var / 4.0); /* RMS over the four corners of the 2-D error */
         if (!isfinite(trial.sigma_px)) continue;
+        memcpy(&general, &trial, sizeof general); /* the most general determined model so far */
         if (score < best_score) {
             best_score = score;
             best = model;
             *out = trial;
         }
     }
+    /* a simpler model's error also holds its misfit: the RMS corner distance to the most
+     * general determined estimate (a static scene's identity is off by the motion it ignores) */
+    if (best >= 0 && general.model > out->model) {
+        double ha[8], hb[8], bias = 0.0;
+        if (to_h(mp->space, out->p, ha) && to_h(mp->space, general.p, hb)) {
+            bias = corner_rms_distance(ha, hb, mp);
+            out->sigma_px = sqrt(out->sigma_px * out->sigma_px + bias * bias);
+        }
+    }
     /* the chosen model must explain the data no worse than an exact homography would, at its
      * cost in parameters (matters when the homography is undetermined); a cap below the
      * homography asks for the best such model whatever its misfit */
     if (best >= 0 && best < HOME_MODEL_HOMOGRAPHY && mp->max_model == HOME_MODEL_HOMOGRAPHY &&
-        !(out->delta <= mp->penalty * (8 - model_basis(mp->space, best, o, basis))))
+        !(out->delta <= mp->penalty * (8 - home__model_basis(mp->space, best, o, basis))))
         return 0;
     return best >= 0;
 }
@@ -235,5 +261,28 @@ const char *home_model_name(int model)
     case HOME_MODEL_AFFINE: return "affine";
     case HOME_MODEL_HOMOGRAPHY: return "homography";
     default: return "unknown";
+    }
+}
+
+void home__project_normal(const double basis[8][8], int k, const double *jtj, const double *jte,
+                          double *jtj_q, double *jte_q)
+{
+    int i, j, a, b;
+    for (i = 0; i < 8; i++) {
+        double s = 0.0;
+        for (a = 0; a < 8 && i < k; a++) s += basis[i][a] * jte[a];
+        jte_q[i] = s;
+        for (j = 0; j < 8; j++) {
+            double t = 0.0;
+            if (i < k && j < k) {
+                for (a = 0; a < 8; a++) {
+                    if (basis[i][a] == 0.0) continue;
+                    for (b = 0; b < 8; b++) t += basis[i][a] * jtj[a * 8 + b] * basis[j][b];
+                }
+            } else {
+                t = i == j ? 1.0 : 0.0; /* unused coordinates: identity, no step */
+            }
+            jtj_q[i * 8 + j] = t;
+        }
     }
 }

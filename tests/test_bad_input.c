@@ -196,6 +196,11 @@ static int y4m(const char *text, size_t size, int frames)
     X(refine_points_above_max, HOME_E_CONFIG, (bad.refine_points = HOME_REFINE_MAX_POINTS + 1, home_validate_config(&bad))) \
     X(refine_finest_negative, HOME_E_CONFIG, (bad.refine_finest_level = -1, home_validate_config(&bad))) \
     X(refine_finest_not_below_levels, HOME_E_CONFIG, (bad.refine_finest_level = bad.refine_levels, home_validate_config(&bad))) \
+    X(max_model_negative, HOME_E_CONFIG, (bad.max_model = -1, home_validate_config(&bad))) \
+    X(max_model_above_homography, HOME_E_CONFIG, (bad.max_model = HOME_MODEL_HOMOGRAPHY + 1, home_validate_config(&bad))) \
+    X(max_sigma_nan, HOME_E_CONFIG, (bad.max_sigma_px = (float)NAN, home_validate_config(&bad))) \
+    X(max_sigma_zero, HOME_E_CONFIG, (bad.max_sigma_px = 0.0f, home_validate_config(&bad))) \
+    X(max_sigma_inf, HOME_E_CONFIG, (bad.max_sigma_px = (float)INFINITY, home_validate_config(&bad))) \
     X(simd_unknown, HOME_E_CONFIG, (bad.simd = 99, home_validate_config(&bad))) \
     X(hough_method_unknown, HOME_E_CONFIG, (bad.hough_method = 7, home_validate_config(&bad))) \
     X(arena_size_null, 0, (int)home_arena_size(NULL)) \
@@ -277,6 +282,9 @@ static int y4m(const char *text, size_t size, int frames)
     X(render_hough_stride_too_small, HOME_E_STRIDE, (home_hough_size(ctx, &hw, &hh), home_render_hough(ctx, img_a, W, hough, hw - 1))) \
     X(keypoint_to_hough_null_keypoint, HOME_E_NULL, home_keypoint_to_hough(ctx, NULL, &col, &row)) \
     X(strerror_unknown_code, 0, strcmp(home_strerror(-12345), "unknown status code")) \
+    X(model_name_unknown, 0, strcmp(home_model_name(-1), "unknown") | strcmp(home_model_name(5), "unknown")) \
+    X(failure_name_unknown, 0, strcmp(home_failure_name(99), "unknown")) \
+    X(refine_status_name_unknown, 0, strcmp(home_refine_status_name(-3), "unknown")) \
     /* PGM reader (examples/pgm.c): refusals return -1 with a reason */ \
     X(pgm_empty, -1, PGM("")) \
     X(pgm_garbage, -1, PGM("\x89PNG\r\n\x1a\n")) \

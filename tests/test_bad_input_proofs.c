@@ -155,6 +155,12 @@ static void job_hough_size(void) { home_hough_size(s_ctx, &s_hw, &s_hh); }
 static void job_render_hough(void) { home_render_hough(s_ctx, da, DW, s_hough, s_hw); }
 static void job_keypoint_to_hough(void) { home_keypoint_to_hough(s_ctx, &s_fa.kp[0], &s_col, &s_row); }
 static void job_strerror(void) { home_strerror(HOME_E_CONFIG); }
+static void job_names(void)
+{
+    home_model_name(HOME_MODEL_SIMILARITY);
+    home_failure_name(HOME_FAIL_UNCERTAIN);
+    home_refine_status_name(HOME_REFINE_ACCEPTED);
+}
 static void job_simd_backend(void) { home_simd_backend(s_ctx); }
 static void job_refine(void) { home_refine(s_ctx, da, DW, db, DW, s_res.H, &s_res); }
 
@@ -211,6 +217,7 @@ void test_stack_painted(void)
         {"home_register", job_register}, {"home_last_features", job_last_features},
         {"home_hough_size", job_hough_size}, {"home_render_hough", job_render_hough},
         {"home_keypoint_to_hough", job_keypoint_to_hough}, {"home_strerror", job_strerror},
+        {"home_model_name, home_failure_name, home_refine_status_name", job_names},
         {"home_simd_backend", job_simd_backend}, {"home_refine", job_refine},
         {"home_stab_init", job_stab_init}, {"home_stab_push (2 frames)", job_stab_push},
         {"home_stab_flush", job_stab_flush}, {"home_stab_warp", job_stab_warp},

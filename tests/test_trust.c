@@ -1,0 +1,188 @@
+/* Registration trust: the predicted accuracy against the truth, motion-model selection (a static
+ * scene is the identity, a shift a translation, the cap honoured) and the refusal of estimates
+ * nothing vouches for. */
+#include "test.h"
+#include "test_util.h"
+#include "synth.h"
+#include <math.h>
+#include <string.h>
+
+#define IMG_W 640
+#define IMG_H 360
+static uint8_t img_a[IMG_W * IMG_H], img_b[IMG_W * IMG_H];
+static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+static void render(enum synth_kind kind, uint32_t variant, const double *h, uint64_t noise_seed,
+                   uint8_t *out)
+{
+    synth_render(kind, variant, h, 2.5, noise_seed, out, IMG_W, IMG_H, IMG_W);
+}
+
+/* Paste a textured block (a moving object) at (x0, y0) of out. */
+static void paste_object(uint8_t *out, int x0, int y0, int w, int h, uint32_t seed)
+{
+    synth_rng rng;
+    int x, y;
+    synth_seed(&rng, seed);
+    for (y = y0; y < y0 + h && y < IMG_H; y++)
+        for (x = x0; x < x0 + w && x < IMG_W; x++) {
+            const int v = ((x / 9 + y / 7) % 2) * 120 + 60 + (int)(20.0 * synth_uniform(&rng));
+            if (x >= 0 && y >= 0) out[y * IMG_W + x] = (uint8_t)v;
+        }
+}
+
+static home_context *context_for(int video, int max_model)
+{
+    home_config cfg;
+    if (video) home_video_config(&cfg, IMG_W, IMG_H);
+    else home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.max_model = max_model;
+    return test_context(IMG_W, IMG_H, &cfg);
+}
+
+/* The same static scene in both frames, new noise, and an object moved across a fifth of the
+ * frame: the identity, exactly, with the defaults and the video preset. */
+void test_static_scene_is_identity(void)
+{
+    int video, k;
+    for (video = 0; video < 2; video++) {
+        home_context *ctx = context_for(video, HOME_MODEL_HOMOGRAPHY);
+        int identities = 0;
+        if (!ctx) { CHECK(0); return; }
+        for (k = 0; k < 4; k++) {
+            home_result res;
+            double err;
+            render(SYNTH_STRUCTURED, 40u + (uint32_t)k, identity, 100u + 2u * (uint64_t)k, img_a);
+            render(SYNTH_STRUCTURED, 40u + (uint32_t)k, identity, 101u + 2u * (uint64_t)k, img_b);
+            paste_object(img_a, 60 + 40 * k, 90, 200, 130, 7u + (uint32_t)k);
+            paste_object(img_b, 72 + 40 * k, 94, 200, 130, 7u + (uint32_t)k);
+            CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+            err = synth_corner_error(res.H, identity, IMG_W, IMG_H);
+            printf("     %s scene %d: ok %d, model %s, sigma %.3f px, error %.4f px\n",
+                   video ? "video" : "defaults", k, res.ok, home_model_name(res.model), res.sigma_px, err);
+            CHECK(res.ok);
+            identities += res.model == HOME_MODEL_IDENTITY;
+            CHECK_LT(err, 0.05);
+        }
+        /* most frames come back as exactly no motion, not a small drifting one */
+        CHECK(identities >= 3);
+    }
+}
+
+/* A pure shift is a translation (2 parameters), and H has exactly that form. */
+void test_shift_is_translation(void)
+{
+    home_context *ctx = context_for(1, HOME_MODEL_HOMOGRAPHY);
+    double h[9] = {1, 0, 3.25, 0, 1, -2.5, 0, 0, 1};
+    home_result res;
+    if (!ctx) { CHECK(0); return; }
+    render(SYNTH_STRUCTURED, 51, identity, 301, img_a);
+    render(SYNTH_STRUCTURED, 51, h, 302, img_b);
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+    printf("     model %s, sigma %.3f px, error %.3f px\n", home_model_name(res.model), res.sigma_px,
+           synth_corner_error(res.H, h, IMG_W, IMG_H));
+    CHECK(res.ok);
+    CHECK_EQ_INT(res.model, HOME_MODEL_TRANSLATION);
+    CHECK(res.H[0] == 1.0 && res.H[4] == 1.0 && res.H[1] == 0.0 && res.H[3] == 0.0);
+    CHECK(res.H[6] == 0.0 && res.H[7] == 0.0);
+    CHECK_LT(synth_corner_error(res.H, h, IMG_W, IMG_H), 0.1);
+}
+
+/* cfg.max_model caps the model: a homography pair registered with SIMILARITY gives a similarity
+ * (h0 = h4, h1 = -h3, no perspective) and never a more general model. */
+void test_model_cap(void)
+{
+    home_context *ctx = context_for(0, HOME_MODEL_SIMILARITY);
+    synth_rng rng;
+    double h[9];
+    home_result res;
+    int k;
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 3; k++) {
+        synth_seed(&rng, 60u + (uint64_t)k);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 4.0, h);
+        render(SYNTH_STRUCTURED, 60u + (uint32_t)k, identity, 401u + 2u * (uint64_t)k, img_a);
+        render(SYNTH_STRUCTURED, 60u + (uint32_t)k, h, 402u + 2u * (uint64_t)k, img_b);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        printf("     pair %d: ok %d, model %s\n", k, res.ok, home_model_name(res.model));
+        CHECK(res.model <= HOME_MODEL_SIMILARITY);
+        CHECK(fabs(res.H[0] - res.H[4]) < 1e-9 && fabs(res.H[1] + res.H[3]) < 1e-9);
+        CHECK(res.H[6] == 0.0 && res.H[7] == 0.0);
+    }
+}
+
+/* The predicted error is calibrated on structured and weakly textured pairs of 10..40 px: every
+ * ok answer within 3 sigma of the truth (+0.02 px of the truth's own rendering), sigma within
+ * max_sigma_px; and so is HOME's line fit alone (no refinement). */
+void test_sigma_calibrated(void)
+{
+    int refine;
+    for (refine = 0; refine < 2; refine++) {
+        home_config cfg;
+        home_context *ctx;
+        int k, ok = 0, within = 0;
+        double worst_ratio = 0;
+        home_default_config(&cfg, IMG_W, IMG_H);
+        if (!refine) cfg.refine_levels = 0;
+        ctx = test_context(IMG_W, IMG_H, &cfg);
+        if (!ctx) { CHECK(0); return; }
+        for (k = 0; k < 12; k++) {
+            const enum synth_kind kind = k % 2 ? SYNTH_WEAK_TEXTURE : SYNTH_STRUCTURED;
+            synth_rng rng;
+            double h[9], err;
+            home_result res;
+            synth_seed(&rng, 700u + (uint64_t)k);
+            synth_corner_homography(&rng, IMG_W, IMG_H, 10.0 + 10.0 * (k % 4), h);
+            render(kind, 700u + (uint32_t)k, identity, 1401u + 2u * (uint64_t)k, img_a);
+            render(kind, 700u + (uint32_t)k, h, 1402u + 2u * (uint64_t)k, img_b);
+            CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+            if (!res.ok) continue;
+            ok++;
+            err = synth_corner_error(res.H, h, IMG_W, IMG_H);
+            CHECK(res.sigma_px > 0 && res.sigma_px <= cfg.max_sigma_px);
+            within += err <= 3.0 * res.sigma_px + 0.02;
+            if (err / res.sigma_px > worst_ratio) worst_ratio = err / res.sigma_px;
+        }
+        printf("     %s: %d of 12 ok, %d within 3 sigma, worst error / sigma %.2f\n",
+               refine ? "refined" : "line fit", ok, within, worst_ratio);
+        CHECK(ok >= 10);
+        CHECK_EQ_INT(within, ok);
+    }
+}
+
+/* A frame of three long edges on flat areas leaves a homography undetermined (two lines' worth
+ * of constraints short): whatever the model cap, an answer is either refused or right. */
+void test_few_edges_never_wrong(void)
+{
+    static const double lines[3][3] = {{0.93, 0.36, -260}, {-0.2, 0.98, -150}, {0.6, -0.8, 40}};
+    double h[9] = {1, 0, 2.0, 0, 1, -1.5, 0, 0, 1};
+    int cap;
+    for (cap = HOME_MODEL_SIMILARITY; cap <= HOME_MODEL_HOMOGRAPHY; cap += 2) {
+        home_context *ctx = context_for(0, cap);
+        home_result res;
+        int pass;
+        if (!ctx) { CHECK(0); return; }
+        for (pass = 0; pass < 2; pass++) {
+            uint8_t *out = pass ? img_b : img_a;
+            synth_rng rng;
+            int x, y, k;
+            synth_seed(&rng, 900u + (uint64_t)pass);
+            for (y = 0; y < IMG_H; y++)
+                for (x = 0; x < IMG_W; x++) {
+                    /* scene point of output pixel (x, y): h^-1 for B (a pure shift here) */
+                    const double sx = pass ? x - h[2] : x, sy = pass ? y - h[5] : y;
+                    double v = 100.0;
+                    for (k = 0; k < 3; k++)
+                        v += 30.0 * (lines[k][0] * sx + lines[k][1] * sy + lines[k][2] > 0);
+                    v += 2.5 * synth_gauss(&rng);
+                    out[y * IMG_W + x] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v + 0.5);
+                }
+        }
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        printf("     cap %s: ok %d, model %s, sigma %.3f px, failure %s, error %.3f px\n",
+               home_model_name(cap), res.ok, home_model_name(res.model), res.sigma_px,
+               home_failure_name(res.failure), synth_corner_error(res.H, h, IMG_W, IMG_H));
+        if (res.ok) CHECK_LT(synth_corner_error(res.H, h, IMG_W, IMG_H), 1.0);
+        if (cap == HOME_MODEL_HOMOGRAPHY) CHECK(!res.ok || res.model < HOME_MODEL_HOMOGRAPHY);
+    }
+}
