@@ -60,6 +60,8 @@ def run_home(exe, args, rec, timeout=120):
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return {"status": "error", "detail": "timeout"}
+    except OSError as e:             # e.g. the binary replaced by a rebuild under us
+        return {"status": "error", "detail": f"cannot run {exe}: {e}"}
     wall = (time.perf_counter() - t0) * 1e3
     if r.returncode != 0:
         return {"status": "error", "ms": wall,
@@ -199,7 +201,7 @@ def main():
                                                       str(REPO / "build/eval-cache")))
     ap.add_argument("--out", default=None,
                     help="report directory (default bench/eval, or <cache>/trust-quick)")
-    ap.add_argument("--video-frames", type=int, default=None, help="default 30 (quick 6)")
+    ap.add_argument("--video-frames", type=int, default=None, help="default 60 (quick 6)")
     ap.add_argument("--static-frames", type=int, default=None, help="default 300 (quick 40)")
     args = ap.parse_args()
 
@@ -217,7 +219,7 @@ def main():
     if bad:
         sys.exit(f"unknown sets/suites {bad}")
     extra = shlex.split(args.extra_args)
-    vframes = args.video_frames or (catalogue.QUICK["video_frames"] if args.quick else 30)
+    vframes = args.video_frames or (catalogue.QUICK["video_frames"] if args.quick else 60)
     sframes = args.static_frames or (catalogue.QUICK["static_frames"] if args.quick else 300)
 
     lib = trust_data.TrustLibrary(cache)

@@ -104,7 +104,22 @@ APPLE = Photo(O, "apple.jpg", "apple: smooth shading")
 MOON = Photo(S, "moon.png", "lunar surface, few faint craters")
 
 # -- test photographs ------------------------------------------------------
-T = {
+@dataclass(frozen=True)
+class NamedPhoto(Photo):
+    """A Photo with an explicit short name (file stems collide across packages:
+    sklearn's flower.jpg and libjxl's flower.png)."""
+    alias: str = None
+
+    @property
+    def name(self):
+        return self.alias or super().name
+
+
+def _named(d):
+    return {k: NamedPhoto(p.source, p.file, p.why, p.crop, alias=k) for k, p in d.items()}
+
+
+T = _named({
     "castle": Photo("palapeli", "castle-maintenon.jpg",
                     "château de Maintenon: towers, roofs, window rows, sky"),
     "bridge": Photo("palapeli", "cincinnati-bridge.jpg",
@@ -141,12 +156,13 @@ T = {
                       crop=(0, 132, 360, 273)),
     "hopper": Photo("matplotlib", "grace_hopper.jpg",
                     "portrait in uniform: fabric, flags, smooth skin"),
-}
+})
 
 # Pairs per image and setting: the test set has fewer photographs than the
 # tuning set's 20 a group, so more pairs each, keeping its groups at least as large.
 PAIRS = {"tuning": 5, "test": 10}
 P_CYCLE = [10, 20, 30, 40, 60]      # groups a-d, g: pair i uses p = P_CYCLE[i % 5]
+CYCLE_PAIRS = 10                    # pairs per image in groups a-d, g (p cycles twice)
 
 GROUPS = [
     # (key, label, kind of settings)
@@ -168,13 +184,13 @@ def still_groups(which):
     if which == "tuning":
         sd = TUNING_SEEDS
         return {
-            "few_edges": _scenes("few_edges", "A", sd[:6], "3-6 edges crossing flat regions")
+            "few_edges": _scenes("few_edges", "A", sd[:10], "3-6 edges crossing flat regions")
             + [Item("white table, a cube and a cylinder: few edges, large flat areas",
                     photo=_tp("image0000")),
                Item("pencil and caps on a plain table", photo=_tp("stuff")),
                Item("dark bars on a white board", photo=_tp("pca_test1"))],
-            "fog_dim": _scenes("fog_horizon", "A", sd[:4], "ridge line in fog")
-            + _scenes("dim_gradient", "A", sd[:2], "dim smooth gradients")
+            "fog_dim": _scenes("fog_horizon", "A", sd[:5], "ridge line in fog")
+            + _scenes("dim_gradient", "A", sd[:4], "dim smooth gradients")
             + [Item("ornate building against the sky, in fog", photo=_tp("home"),
                     condition="fog"),
                Item("launch towers, in fog", photo=_tp("rocket"), condition="fog"),
@@ -185,22 +201,22 @@ def still_groups(which):
                                     _tp("motorcycle_left"), _tp("graf1"))]
             + _scenes("few_edges", "A", sd[6:8], "few edges in low light", "lowlight")
             + _scenes("repeated", "A", sd[6:8], "repeated pattern in low light", "lowlight"),
-            "repeated": _scenes("repeated", "A", sd[:6], "tiles or a fence")
+            "repeated": _scenes("repeated", "A", sd[:8], "tiles or a fence")
             + [Item("brick wall", photo=_tp("brick")),
                Item("printed sudoku grid", photo=_tp("sudoku")),
                Item("calibration chessboard", photo=_tp("left01"))],
             "line_rich": [Item(p.why, photo=p) for p in LINEAR],
             "decay": [Item(p.why, photo=p) for p in NORMAL],
-            "textureless": _scenes("textureless", "A", sd[:6], "large smooth blobs")
+            "textureless": _scenes("textureless", "A", sd[:8], "large smooth blobs")
             + [Item("apple: smooth shading", photo=APPLE),
                Item("lunar surface", photo=MOON)],
         }
     sd = TEST_SEEDS
     return {
-        "few_edges": _scenes("few_edges", "B", sd[:6], "wall, floor line and a door")
-        + _scenes("few_edges", "A", sd[:3], "3-6 edges crossing flat regions (test seeds)"),
-        "fog_dim": _scenes("fog_horizon", "B", sd[:4], "sea horizon in haze")
-        + _scenes("dim_gradient", "B", sd[:2], "two dim planes meeting softly")
+        "few_edges": _scenes("few_edges", "B", sd[:9], "wall, floor line and a door")
+        + _scenes("few_edges", "A", sd[:4], "3-6 edges crossing flat regions (test seeds)"),
+        "fog_dim": _scenes("fog_horizon", "B", sd[:5], "sea horizon in haze")
+        + _scenes("dim_gradient", "B", sd[:4], "two dim planes meeting softly")
         + [Item("cliff and misty mountains, in fog", photo=T["cliff"], condition="fog"),
            Item("pagoda over a lake, in fog", photo=T["china"], condition="fog"),
            Item("château, in fog", photo=T["castle"], condition="fog")],
@@ -209,7 +225,7 @@ def still_groups(which):
                                 "face", "tulips")]
         + _scenes("few_edges", "B", sd[6:8], "few edges in low light", "lowlight")
         + _scenes("repeated", "B", sd[6:8], "repeated pattern in low light", "lowlight"),
-        "repeated": _scenes("repeated", "B", sd[:8], "bricks, windows or a chain-link fence")
+        "repeated": _scenes("repeated", "B", sd[:11], "bricks, windows or a chain-link fence")
         + [Item(T["parrot"].why, photo=T["parrot"])],
         "line_rich": [Item(T[k].why, photo=T[k]) for k in
                       ("castle", "bridge", "china", "room", "station", "pantheon", "ascent",
@@ -217,7 +233,7 @@ def still_groups(which):
         "decay": [Item(T[k].why, photo=T[k]) for k in
                   ("citrus", "bee", "chameleon", "dahlia", "flowers", "milla", "tulips",
                    "branch", "aero", "face", "hopper")],
-        "textureless": _scenes("textureless", "B", sd[:6], "cosine field and a soft shadow")
+        "textureless": _scenes("textureless", "B", sd[:8], "cosine field and a soft shadow")
         + [Item("tulips, defocused to smooth shading", photo=T["tulips"], condition="defocus"),
            Item("cliff and sea, defocused", photo=T["cliff"], condition="defocus")],
     }
@@ -251,11 +267,14 @@ def static_clips(which):
         tex = [_tp("graf1"), _tp("baboon"), _tp("board"), _tp("chelsea")]
         return [(Item("hotel facade (static), objects moving in front",
                       photo=_tp("building_crop")), tex),
+                (Item("office wall and door frame (static), objects moving in front",
+                      photo=_tp("basketball1")), tex),
                 (Item("flat wall with few edges (static), objects moving in front",
                       scene=("few_edges", "A", "static0")), tex)]
     tex = [T["citrus"], T["face"], T["bee"], T["aero"]]
     return [(Item("interior (static), objects moving in front", photo=T["room"]), tex),
-             (Item("sea horizon in haze (static), objects moving in front",
+            (Item("station hall (static), objects moving in front", photo=T["station"]), tex),
+            (Item("sea horizon in haze (static), objects moving in front",
                    scene=("fog_horizon", "B", "static0")), tex)]
 
 
@@ -263,3 +282,21 @@ QUICK = {
     "items_per_group": 1, "pairs": 1, "p": [10, 60], "alpha": [0.0, 0.95],
     "video_scenes": 1, "video_frames": 6, "static_frames": 40, "static_clips": 1,
 }
+
+
+def _check_names():
+    """Item names are directory names in the cache: unique within a group and
+    set, and a photograph name means one file."""
+    files = {}
+    for which in SETS:
+        for g, items in still_groups(which).items():
+            names = [it.name for it in items]
+            assert len(names) == len(set(names)), (which, g, names)
+            for it in items:
+                if it.photo:
+                    key = it.photo.name + str(it.photo.crop)
+                    f = (it.photo.source, it.photo.file)
+                    assert files.setdefault(key, f) == f, (key, f, files[key])
+
+
+_check_names()

@@ -123,8 +123,9 @@ def pair_plan(which, group, items, quick, catalogue):
             al = catalogue.QUICK["alpha"] if quick else pairs_eval.ALPHAS
             plan += [(it, pairs_eval.DECAY_P, a, i) for a in al for i in range(n)]
         else:
+            m = n if quick else catalogue.CYCLE_PAIRS
             plan += [(it, catalogue.P_CYCLE[i % len(catalogue.P_CYCLE)], 0.0, i)
-                     for i in range(n)]
+                     for i in range(m)]
     return plan
 
 
