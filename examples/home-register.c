@@ -290,9 +290,10 @@ int main(int argc, char **argv)
     printf(",\"model\":\"%s\",\"sigma_px\":", home_model_name(res.model));
     if (isfinite(res.sigma_px)) printf("%.6g", res.sigma_px);
     else printf("null"); /* not determined: JSON has no infinity */
-    printf(",\"failure\":\"%s\",\"refine_status\":\"%s\",\"refine_zncc\":%.4f,\"ms\":{",
+    printf(",\"failure\":\"%s\",\"refine_status\":\"%s\",\"refine_zncc\":%.4f,"
+           "\"refine_inlier_share\":%.4f,\"ms\":{",
            home_failure_name(res.failure), home_refine_status_name(res.refine_status),
-           res.refine_zncc);
+           res.refine_zncc, res.refine_inlier_share);
     for (s = 0; s < HOME_STAGE_COUNT; s++) printf("%s\"%s\":%.3f", s ? "," : "", stage_names[s], ms[s]);
     if (repeat > 1) printf(",\"frame\":%.3f", frame_ms);
     printf("}}\n");

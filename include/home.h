@@ -242,6 +242,8 @@ typedef struct home_result {
     double refine_error[2];   /* robust photometric error (mean Geman-McClure cost, grey^2) of
                                  HOME's H and of the refined H over the points both keep */
     double refine_zncc;       /* weighted correlation of A and gain/bias-corrected B there */
+    double refine_inlier_share; /* share of those points within 3 robust sigmas under the
+                                 refined H (parts of the scene left misaligned lower it) */
     double ms[HOME_STAGE_COUNT]; /* per-stage milliseconds (0 without a clock) */
 } home_result;
 
@@ -262,8 +264,12 @@ typedef struct home_result {
  * least 8 inliers) is refined. An accepted refinement within max(refine_trust_px, 3 sigma_px)
  * of HOME's H agrees with it: the result is the refined H, ok when HOME's was, or when the
  * photometric fit vouches for it (refine_zncc >= 0.9). Farther away the two disagree: the
- * refined H is the result only when it vouches for itself, else the pair fails
- * (HOME_FAIL_INCONSISTENT). A declined refinement leaves HOME's H, sigma and ok. */
+ * refined H is the result only when it vouches for the whole frame (refine_zncc >= 0.9 and
+ * refine_inlier_share >= 0.9), else the pair fails (HOME_FAIL_INCONSISTENT). A refinement that
+ * cannot converge although the frame has texture refutes HOME's estimate (INCONSISTENT too);
+ * one declined for another reason leaves HOME's H, sigma and ok. When HOME finds no estimate,
+ * direct alignment from the identity is tried; it vouches like an overruling refinement and
+ * must stay within refine_trust_px of the identity. */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 

@@ -47,6 +47,8 @@
                                   (calibrated on the evaluation's tuning set: neighbouring
                                   template points do not carry independent noise) */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
+#define VOUCH_SHARE 0.9      /* ... and, against HOME's estimate or with none, with this share
+                                of its points within 3 robust sigmas */
 
 /* Block side of the point selection per level: 4x4, and 2x2 at quarter resolution so that level
  * still offers more candidates than its capacity. */
@@ -334,6 +336,8 @@ typedef struct solver {
                                            (set once the finest level converged) */
     double split_px;                    /* split-half disagreement of the last finest step */
     int finest;                         /* level the estimate ends at */
+    int k;                              /* parameters of the model fitted (8: a homography) */
+    double basis[8][8];                 /* the update's subspace dp = B q when k < 8 */
     float *img_b, *img_b2, *res, *wt;   /* per-point scratch */
 } solver;
 
@@ -504,6 +508,23 @@ static void normal_equations(const float *acc, unsigned lane_mask, double k, dou
     }
 }
 
+/* x = B (B^T a B)^-1 B^T b: the solve in the model's parameters (a and b are overwritten; with
+ * all 8, a plain solve). 0 when not positive definite. */
+static int model_solve(const solver *s, double *a, double *b)
+{
+    double aq[64], bq[8];
+    int i, j;
+    if (s->k == 8) return home__solve_spd8(a, b);
+    home__project_normal(s->basis, s->k, a, b, aq, bq);
+    if (!home__solve_spd(aq, bq, s->k)) return 0;
+    for (j = 0; j < 8; j++) {
+        double v = 0.0;
+        for (i = 0; i < s->k; i++) v += bq[i] * s->basis[i][j];
+        b[j] = v;
+    }
+    return 1;
+}
+
 /* One IRLS Gauss-Newton step at a level. Returns 0 when too few points stay usable or the
  * system is singular; *step_px gets the corner motion of the update. */
 static int iterate(solver *s, int level, double *step_px)
@@ -542,14 +563,14 @@ static int iterate(solver *s, int level, double *step_px)
         double ae[64], ge[8], ao[64], go[8];
         normal_equations(acc, 0x5, k, ae, ge);
         normal_equations(acc, 0xa, k, ao, go);
-        if (home__solve_spd8(ae, ge) && home__solve_spd8(ao, go)) {
+        if (model_solve(s, ae, ge) && model_solve(s, ao, go)) {
             for (p = 0; p < 8; p++) ge[p] -= go[p];
             s->split_px = 0.5 * corner_step_px(s, ge);
         } else {
             s->split_px = INFINITY;
         }
     }
-    if (!home__solve_spd8(a, g)) return 0;
+    if (!model_solve(s, a, g)) return 0;
     for (p = 0; p < 8; p++) dp[p] = g[p];
     *step_px = corner_step_px(s, dp);
     hd[0] = 1 + dp[0]; hd[1] = dp[1]; hd[2] = dp[2];
@@ -594,7 +615,7 @@ static double corner_std_px(const solver *s)
             else { jc[3] = u; jc[4] = v; jc[5] = 1; jc[6] = -u * v; jc[7] = -v * v; }
             memcpy(a, s->jtj, sizeof a);
             memcpy(z, jc, sizeof z);
-            if (!home__solve_spd8(a, z)) return INFINITY;
+            if (!model_solve(s, a, z)) return INFINITY;
             for (i = 0; i < 8; i++) q += jc[i] * z[i];
             var += q;
         }
@@ -631,6 +652,26 @@ static double photometric_error(solver *s, const float *img_b, const float *othe
         if (va > 0 && vb > 0) *zncc = (sab - sa * sb / sw) / sqrt(va * vb);
     }
     return n ? cost / n : INFINITY;
+}
+
+/* Share of the points (valid under both estimates) whose residual under the estimate of img_b
+ * (s->res, left by photometric_error) is within 3 robust sigmas of its own: a refinement that
+ * aligned part of the scene (two edges of three, say) leaves the rest far off, and the robust
+ * weights that let it ignore them also hide them from the weighted correlation. */
+static double inlier_share(solver *s, const float *img_b, const float *other_b)
+{
+    const home__refine_points *tp = &s->tpl[s->finest];
+    double sigma, limit;
+    int i, n = 0, in = 0;
+    /* the scale from the residuals (robust_sigma's histogram bins go to the weights' scratch) */
+    sigma = robust_sigma(img_b, tp->t, tp->n, s->alpha, s->beta, (int32_t *)(void *)s->wt);
+    limit = 3.0 * sigma;
+    for (i = 0; i < tp->n; i++) {
+        if (img_b[i] < 0.0f || other_b[i] < 0.0f) continue;
+        n++;
+        in += fabs(s->res[i]) <= limit;
+    }
+    return n ? (double)in / n : 0.0;
 }
 
 static double max_corner_distance(const solver *s, const double *h1, const double *h2)
@@ -730,6 +771,13 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     s.wt = scratch + 3 * cap;
     s.alpha = 1.0;
     s.hessian_level = -1;
+    /* below a homography the update stays in the model (it is a group: I + D(dp) in it keeps
+     * the estimate in it), so a few edges that leave a homography undetermined still fix it */
+    s.k = 8;
+    if (ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY) {
+        double o[8];
+        s.k = home__model_basis(HOME__SPACE_H, ctx->cfg.max_model, o, s.basis);
+    }
     to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
     for (s.finest = st->finest_level; s.finest < st->levels - 1; s.finest++)
@@ -784,6 +832,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
         sigma0 = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta, (int32_t *)(void *)s.wt);
         e0 = photometric_error(&s, s.img_b, s.img_b2, sigma0, &zncc0);
         e1 = photometric_error(&s, s.img_b2, s.img_b, sigma0, &zncc1);
+        result->refine_inlier_share = inlier_share(&s, s.img_b2, s.img_b);
     }
     result->refine_error[0] = e0;
     result->refine_error[1] = e1;
@@ -841,6 +890,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         /* a local method vouches only within its reach: the identity is a start whose
          * uncertainty is the trust floor */
         if (trial.refined && trial.refine_zncc >= VOUCH_ZNCC &&
+            trial.refine_inlier_share >= VOUCH_SHARE &&
             trial.sigma_px <= ctx->cfg.max_sigma_px &&
             corner_distance(ctx, trial.H, identity) <= ctx->cfg.refine_trust_px * ctx->hough_scale) {
             trial.ok = 1;
@@ -860,7 +910,8 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         d = corner_distance(ctx, trial.H, result->H);
         agrees = d <= radius;
         vouches = trial.refine_zncc >= VOUCH_ZNCC;
-        if (agrees ? result->ok || vouches : vouches) {
+        /* overruling HOME takes the whole frame: nearly every point consistent */
+        if (agrees ? result->ok || vouches : vouches && trial.refine_inlier_share >= VOUCH_SHARE) {
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
         } else {
