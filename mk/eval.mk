@@ -3,7 +3,7 @@
 #   make eval-quick  the CI subset: report in $(EVAL_CACHE)/quick/results.md
 #   make eval-trust        issue 16: can `ok` be trusted? tuning set vs sealed test set, still
 #                          pairs, consecutive frames, static camera; rewrites
-#                          bench/eval/trust_results.md, trust_results.json and trust_*.png
+#                          bench/eval/trust_results.md, trust_results.json.gz and trust_*.png
 #   make eval-trust-quick  its CI subset (report in $(EVAL_CACHE)/trust-quick/; fails only when
 #                          the harness breaks, never on the numbers)
 # Photographs come from Debian packages (apt-get download) into $(EVAL_CACHE).

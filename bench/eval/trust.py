@@ -21,13 +21,14 @@ decides failure; optional JSON fields "sigma_px", "model" and "refine_status"
 are reported where the binary gives them ("n/a" where it does not).
 
 Generated data is cached under <cache>/trust/<set>/ (reruns skip generation);
-the results go to <out>/trust_results.json (compact, enough to redraw the report
-with `trust_report.py <out>/trust_results.json`) and <cache>/trust-runs/*.json
+the results go to <out>/trust_results.json.gz (compact, enough to redraw the report
+with `trust_report.py <out>/trust_results.json.gz`) and <cache>/trust-runs/*.json
 (every H).  Exit status: non-zero only when the harness itself breaks
 (home-register crashing or printing no JSON on generated inputs, no pairs).
 """
 import argparse
 import csv
+import gzip
 import json
 import os
 import platform
@@ -201,6 +202,9 @@ def main():
                                                       str(REPO / "build/eval-cache")))
     ap.add_argument("--out", default=None,
                     help="report directory (default bench/eval, or <cache>/trust-quick)")
+    ap.add_argument("--label", default=None,
+                    help="the binary's commit for the report (default: git describe of "
+                         "the binary's directory)")
     ap.add_argument("--video-frames", type=int, default=None, help="default 60 (quick 6)")
     ap.add_argument("--static-frames", type=int, default=None, help="default 300 (quick 40)")
     args = ap.parse_args()
@@ -269,7 +273,7 @@ def main():
     meta = {
         "quick": args.quick, "home": args.home, "stab": stab, "extra_args": extra,
         "configs": {c: " ".join(["home-register"] + a + extra) for c, a in CONFIGS.items()},
-        "commit": git_describe(Path(args.home).resolve().parent),
+        "commit": args.label or git_describe(Path(args.home).resolve().parent),
         "opencv": cv2.__version__, "python": platform.python_version(),
         "machine": f"{platform.machine()}, {os.cpu_count()} cores", "jobs": args.jobs,
         "packages": lib.versions, "wall_s": wall, "timing_s": timing,
@@ -284,7 +288,8 @@ def main():
                                                   "clips": clips}))
     compact_clips = [{k: v for k, v in c.items() if k != "y4m"} for c in clips]
     results = {"meta": meta, "records": compact(records), "clips": compact_clips}
-    (out / "trust_results.json").write_text(json.dumps(results, separators=(",", ":")))
+    (out / "trust_results.json.gz").write_bytes(gzip.compress(
+        json.dumps(results, separators=(",", ":")).encode(), mtime=0))
     trust_report.write(out, results)
     print(f"report: {out / 'trust_results.md'} ({wall:.0f} s); every H: {runs / (tag + '.json')}")
 

