@@ -220,7 +220,9 @@ enum home_refine_status {
     HOME_REFINE_OUTSIDE_TRUST,    /* the refined H is farther from HOME's than refine_trust_px
                                      and 3x HOME's sigma_px, and cannot vouch for itself */
     HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
-    HOME_REFINE_LOW_CORRELATION   /* HOME failed and the refinement cannot vouch (rule below) */
+    HOME_REFINE_LOW_CORRELATION,  /* HOME failed and the refinement cannot vouch (rule below) */
+    HOME_REFINE_LESS_PRECISE      /* the refined H agrees with HOME's but predicts a larger
+                                     error (sigma_px): HOME's H stays */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */

@@ -41,8 +41,10 @@
 #define FINEST_MIN_POINTS 512 /* the level the estimate ends at needs this many points, else the
                                  next coarser one is the finest (faint texture: less noise there) */
 #define STEP_EPS_PX 0.02    /* convergence: largest corner update, full-resolution px */
-#define MAX_CORNER_STD_PX 0.5 /* corner standard deviation (Fisher or split-half) above this:
-                                 ill conditioned */
+#define STEP_NOISE_SHARE 0.25 /* ... or at the finest level, this share of the worst corner's
+                                 predicted standard deviation */
+#define MAX_CORNER_STD_PX 0.5 /* worst corner's standard deviation (Fisher, or split-half) above
+                                 this, or above max_sigma_px: ill conditioned */
 #define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
                                   (calibrated on the evaluation's tuning set: neighbouring
                                   template points do not carry independent noise) */
@@ -754,10 +756,11 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
 {
     const home__refine_state *st = &ctx->refine;
     solver s;
-    double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0;
+    double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0, refined_std;
     int level, it, converged = 0, iterations = 0;
     float *scratch = (float *)st->scratch;
     const int cap = level_capacity(&ctx->cfg, st->finest_level);
+    const double max_std = MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
 
     memset(&s, 0, sizeof s);
     s.st = st;
@@ -796,6 +799,12 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
                 return;
             }
             if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
+            /* at the finest level, also a step far below the estimate's own predicted
+             * uncertainty: noisy frames (low light) keep the steps jittering at that scale */
+            if (level == s.finest) {
+                s.resid_var = residual_variance(&s);
+                if (step < STEP_NOISE_SHARE * corner_std_px(&s)) { converged = 1; break; }
+            }
             /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
             if (step > 0.5 * last_step) s.hessian_level = -1;
             last_step = step;
@@ -805,7 +814,8 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return; }
     to_pixels(&s, s.hn, h1);
     s.resid_var = residual_variance(&s);
-    if (corner_std_px(&s) > MAX_CORNER_STD_PX || !(s.split_px <= MAX_CORNER_STD_PX)) {
+    refined_std = corner_std_px(&s);
+    if (refined_std > max_std || !(s.split_px <= max_std)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return;
     }
@@ -837,7 +847,12 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     result->refine_error[0] = e0;
     result->refine_error[1] = e1;
     result->refine_zncc = zncc1;
-    if (!(e1 < e0)) { result->refine_status = HOME_REFINE_NOT_LOWER; return; }
+    /* not lower: a divergence, or (noisy frames) the start was already the optimum within the
+     * refined estimate's own uncertainty, which then stands */
+    if (!(e1 < e0) && !(max_corner_distance(&s, h1, h0) <= 3.0 * refined_std)) {
+        result->refine_status = HOME_REFINE_NOT_LOWER;
+        return;
+    }
     if (!choose_model(&s, ctx->cfg.max_model, h1, result)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return;
@@ -906,12 +921,18 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     } else if (trial.refined) {
         /* HOME's own precision scales with the Hough image's pixel: so does the floor */
         radius = ctx->cfg.refine_trust_px * ctx->hough_scale;
-        if (3.0 * result->sigma_px > radius) radius = 3.0 * result->sigma_px;
+        if (isfinite(result->sigma_px) && 3.0 * result->sigma_px > radius)
+            radius = 3.0 * result->sigma_px;
         d = corner_distance(ctx, trial.H, result->H);
         agrees = d <= radius;
         vouches = trial.refine_zncc >= VOUCH_ZNCC;
         /* overruling HOME takes the whole frame: nearly every point consistent */
-        if (agrees ? result->ok || vouches : vouches && trial.refine_inlier_share >= VOUCH_SHARE) {
+        if (agrees && result->sigma_px <= trial.sigma_px) {
+            /* consistent, and HOME's line fit predicts the smaller error: it stays */
+            trial = *result;
+            trial.refine_status = HOME_REFINE_LESS_PRECISE;
+            trial.refine_zncc = 0.0;
+        } else if (agrees ? result->ok || vouches : vouches && trial.refine_inlier_share >= VOUCH_SHARE) {
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
         } else {
@@ -949,10 +970,11 @@ int home_refine(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const u
     if (!(fabs(h_init[8]) > 1e-12)) return HOME_E_CONFIG;
     memset(result, 0, sizeof *result);
     for (k = 0; k < 9; k++) result->H[k] = h_init[k] / h_init[8];
-    /* the caller's estimate counts as exact: the refinement may move it by refine_trust_px,
-     * farther only when the photometric fit vouches for itself */
+    /* the refinement may move the caller's estimate by refine_trust_px, farther only when the
+     * photometric fit vouches for the whole frame */
     result->ok = 1;
     result->model = HOME_MODEL_HOMOGRAPHY;
+    result->sigma_px = INFINITY; /* unknown: any refined estimate is more precise */
     t0 = home__now(ctx);
     id_a = home__refine_store(ctx, a, stride_a);
     id_b = home__refine_store(ctx, b, stride_b);
