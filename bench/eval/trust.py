@@ -155,8 +155,12 @@ def run_stab(stab, clip):
            "final_angle_deg": float(np.degrees(float(last["raw_angle"]))),
            "max_drift_px": max(drift), "final_drift_px": drift[-1],
            "max_angle_deg": max(abs(np.degrees(float(x["raw_angle"]))) for x in rows)}
-    for c in extra_cols:                # sigma / model per frame, when home-stab has them
-        out.setdefault("extra_columns", []).append(c)
+    out["extra_columns"] = extra_cols   # e.g. model and sigma_px per frame, when present
+    if "model" in rows[0]:
+        models = {}
+        for x in rows[1:]:
+            models[x["model"]] = models.get(x["model"], 0) + 1
+        out["models"] = models
     return out
 
 
@@ -227,15 +231,17 @@ def main():
     sframes = args.static_frames or (catalogue.QUICK["static_frames"] if args.quick else 300)
 
     lib = trust_data.TrustLibrary(cache)
-    photos = set()
+    q = catalogue.QUICK if args.quick else {}
+    photos = set()                   # only what this run uses: --quick fetches less
     for s in sets:
         if "pairs" in suites:
-            photos |= {it.photo for its in catalogue.still_groups(s).values() for it in its
-                       if it.photo}
+            photos |= {it.photo for its in catalogue.still_groups(s).values()
+                       for it in its[:q.get("items_per_group")] if it.photo}
         if "video" in suites:
-            photos |= {it.photo for it in catalogue.video_scenes(s) if it.photo}
+            photos |= {it.photo for it in catalogue.video_scenes(s)[:q.get("video_scenes")]
+                       if it.photo}
         if "static" in suites:
-            for bg, tex in catalogue.static_clips(s):
+            for bg, tex in catalogue.static_clips(s)[:q.get("static_clips")]:
                 photos |= set(tex) | ({bg.photo} if bg.photo else set())
     lib.fetch(sorted(photos, key=lambda p: (p.source, p.file)))
 

@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """trust_results.json -> trust_results.md and the trust_*.png plots.
 
-  python3 bench/eval/trust_report.py RESULTS.json[.gz] [OUT_DIR [STEM]]
+  python3 bench/eval/trust_report.py RESULTS.json[.gz] [OUT_DIR [STEM]] [--compare OTHER LABEL]
       redraw without rerunning: OUT_DIR/STEM.md (default trust_results.md) and
-      OUT_DIR/STEM_{reliability,silent,static_drift}.png (default trust_*.png)
+      OUT_DIR/STEM_{reliability,silent,static_drift}.png (default trust_*.png);
+      --compare appends another run's headline and bounds tables (e.g. the baseline)
 """
 import gzip
 import json
 import math
-import sys
 from collections import Counter
 from pathlib import Path
 
@@ -106,9 +106,12 @@ def _res(recs, cfg):
 
 
 def group_table(records, suite, cfg, sets):
+    models = any(x.get("model") for r in _select(records, suite=suite)
+                 for x in [r["results"].get(cfg, {})])
     head = "| group |" + "".join(
-        f" {s}: n | mean ok px | fail | silent > 2 px (n, max) | > 3σ |" for s in sets)
-    lines = [head, "|---|" + "---|---|---|---|---|" * len(sets)]
+        f" {s}: n | mean ok px | fail | silent > 2 px (n, max) | > 3σ |"
+        + (" models |" if models else "") for s in sets)
+    lines = [head, "|---|" + ("---|---|---|---|---|" + ("---|" if models else "")) * len(sets)]
     rows = _rows(records, suite)
     for row in rows + ["all"]:
         cells = []
@@ -117,10 +120,11 @@ def group_table(records, suite, cfg, sets):
                 _select(records, suite=suite, set=s, row=row)
             st = stats(_res(recs, cfg))
             if not st["n"]:
-                cells.append(" – | – | – | – | – |")
+                cells.append(" – | – | – | – | – |" + (" – |" if models else ""))
                 continue
             cells.append(f" {st['n']} | {f_px(st['mean_ok'], st['mean_ok_inf'])} | "
-                         f"{f_pct(st['fail_pct'])} | {f_silent(st)} | {f_calib(st)} |")
+                         f"{f_pct(st['fail_pct'])} | {f_silent(st)} | {f_calib(st)} |"
+                         + (f" {f_models(st)} |" if models else ""))
         name = "**all**" if row == "all" else row
         lines.append(f"| {name} |" + "".join(cells))
     return "\n".join(lines)
@@ -226,6 +230,9 @@ def static_table(records, clips, sets, cfgs):
         sb = cl["stab"]
         stab_cell = (f"{sb['final_drift_px']:.2f} / {sb['max_drift_px']:.2f}, "
                      f"{sb['max_angle_deg']:.2f}°" if sb["status"] == "ok" else sb["status"])
+        if sb.get("models"):
+            stab_cell += "; models " + " ".join(
+                f"{m} {n}" for m, n in sorted(sb["models"].items(), key=lambda kv: -kv[1]))
         for i, c in enumerate(cfgs):
             st = stats(_res(recs, c))
             ch = cl["chain"][c]
@@ -320,7 +327,8 @@ def plot_reliability(path, records, sets, cfgs):
             sg, er = np.array(pts, float).T
             sg = np.maximum(sg, 1e-4)
             er = np.maximum(er, 1e-4)
-            ax.scatter(sg, er, s=4, alpha=0.25, color="0.5", label="ok answers")
+            ax.scatter(sg, er, s=4, alpha=0.25, color="0.5", label="ok answers",
+                       rasterized=True)
             edges = np.logspace(np.floor(np.log10(sg.min())), np.ceil(np.log10(sg.max())),
                                 13)
             mids, mean, rms, cnt = [], [], [], []
@@ -440,8 +448,9 @@ def load(path):
     return json.loads(raw)
 
 
-def write(out_dir, results, stem="trust_results"):
-    """STEM.md and the plots (trust_results -> trust_*.png, else STEM_*.png)."""
+def write(out_dir, results, stem="trust_results", compare=None):
+    """STEM.md and the plots (trust_results -> trust_*.png, else STEM_*.png);
+    compare = (label, other results): their headline and bounds tables appended."""
     out_dir = Path(out_dir)
     png = "trust" if stem == "trust_results" else stem
     meta, records, clips = results["meta"], results["records"], results["clips"]
@@ -475,6 +484,17 @@ def write(out_dir, results, stem="trust_results"):
     L.append(headline(records, sets, cfgs, suites) + "\n")
     L.append("## Issue 16's bounds (✓ met, ✗ not; the worst group or condition)\n")
     L.append(criteria(records, clips, sets, cfgs) + "\n")
+    if compare:
+        label, other = compare
+        om, orec = other["meta"], other["records"]
+        osets = [s for s in om["sets"] if any(r["set"] == s for r in orec)]
+        ocfgs = list(om["configs"])
+        osuites = [s for s in ("pairs", "video", "static") if _select(orec, suite=s)]
+        L.append(f"## Compared with {label}\n")
+        L.append(f"The same data registered by the binary at `{om['commit']}`"
+                 f" ({om['wall_s'] / 60:.1f} min wall):\n")
+        L.append(headline(orec, osets, ocfgs, osuites) + "\n")
+        L.append(criteria(orec, other["clips"], osets, ocfgs) + "\n")
     if "pairs" in suites:
         L.append("## Still pairs\n")
         L.append("The paper's protocol (854x480 cover, corners moved uniformly in [-p, p], "
@@ -567,13 +587,19 @@ def write(out_dir, results, stem="trust_results"):
 
 
 def main():
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    path = Path(sys.argv[1])
-    out = Path(sys.argv[2]) if len(sys.argv) > 2 else path.parent
-    stem = sys.argv[3] if len(sys.argv) > 3 else "trust_results"
-    write(out, load(path), stem)
-    print(out / f"{stem}.md")
+    import argparse
+    ap = argparse.ArgumentParser(description="redraw the trust report from its results")
+    ap.add_argument("results", help="trust_results.json[.gz]")
+    ap.add_argument("out_dir", nargs="?", default=None)
+    ap.add_argument("stem", nargs="?", default="trust_results")
+    ap.add_argument("--compare", nargs=2, metavar=("OTHER.json.gz", "LABEL"),
+                    help="append another run's headline and bounds tables")
+    a = ap.parse_args()
+    path = Path(a.results)
+    out = Path(a.out_dir) if a.out_dir else path.parent
+    cmp = (a.compare[1], load(a.compare[0])) if a.compare else None
+    write(out, load(path), a.stem, cmp)
+    print(out / f"{a.stem}.md")
 
 
 if __name__ == "__main__":
