@@ -16,6 +16,9 @@ other seeds).  Sources of the test photographs:
   libjxl-testdata      JPEG XL conformance photographs (usr/share/libjxl-testdata)
   hugin-data           Hugin's manual: photographs shown in its help pages
   python-matplotlib-data  Matplotlib's sample_data photograph
+  gcompris-qt-data     GCompris's activities: monuments (explore_monuments.rcc, 1024 px)
+                       and animals in nature (erase.rcc, 1920x1080); "FILE.rcc#K" is the
+                       K-th WebP image in the Qt resource file (see trust_data.rcc_webp)
 
 Reserved for independent checks and never used here: Debian's desktop wallpaper
 and background packages (desktop-base, *-backgrounds, *-wallpapers),
@@ -45,6 +48,7 @@ TEST_PACKAGES = {
     "libjxl": ("libjxl-testdata", "usr/share/libjxl-testdata"),
     "hugin": ("hugin-data", "usr/share/hugin/xrc/data/help_en_EN"),
     "matplotlib": ("python-matplotlib-data", "usr/share/matplotlib/mpl-data/sample_data"),
+    "gcompris": ("gcompris-qt-data", "usr/share/gcompris-qt/rcc"),
 }
 TEST_LICENCES = {
     "palapeli": "KDE palapeli-data (photographs from Wikimedia Commons; see the package's "
@@ -59,6 +63,8 @@ TEST_LICENCES = {
               "copyright file)",
     "hugin": "Hugin manual images (GPL-2+ / CC-BY-SA, see the package's copyright file)",
     "matplotlib": "Matplotlib sample data (grace_hopper.jpg: public domain, US Navy)",
+    "gcompris": "GCompris data (photographs under free licences, each listed in the "
+                "package's copyright file)",
 }
 PACKAGES.update(TEST_PACKAGES)
 LICENCES.update(TEST_LICENCES)
@@ -158,9 +164,54 @@ T = _named({
                     "portrait in uniform: fabric, flags, smooth skin"),
 })
 
-# Pairs per image and setting: the test set has fewer photographs than the
-# tuning set's 20 a group, so more pairs each, keeping its groups at least as large.
-PAIRS = {"tuning": 5, "test": 10}
+
+def _gm(k, why):
+    return Photo("gcompris", f"explore_monuments.rcc#{k}", why)
+
+
+def _ge(k, why):
+    return Photo("gcompris", f"erase.rcc#{k}", why)
+
+
+T.update(_named({
+    # monuments: mostly line-rich, some with few edges on large flat areas or in haze
+    "arena": _gm(1, "Roman arena: two storeys of arches, paving, sky"),
+    "chambord": _gm(3, "Chambord château over a lawn: roofs, chimneys, clouds"),
+    "cathedral": _gm(6, "Gothic cathedral: buttresses, windows, a grass slope"),
+    "carcassonne": _gm(7, "walled city: towers and crenellations on a hill"),
+    "st_michel": _gm(8, "Mont-Saint-Michel over tidal flats: a horizon, a low island"),
+    "aqueduct": _gm(9, "Pont du Gard: three rows of repeated arches over trees"),
+    "pyramid_dark": _gm(10, "a pyramid on the desert: few long edges, flat sand and sky"),
+    "pyramid_haze": _gm(12, "a pyramid in desert haze: faint edges, smooth gradients"),
+    "pyramid_red": _gm(13, "a pyramid on a plain: few long edges, flat ground and sky"),
+    "india_gate": _gm(16, "India Gate at night: lit arch, dark sky, palm trees"),
+    "mysore": _gm(17, "Mysore palace: arcades, domes, a lawn"),
+    "hawa_mahal": _gm(23, "Hawa Mahal: a facade of hundreds of repeated windows"),
+    "victoria": _gm(24, "Victoria Memorial: a white marble building, flat sky, a lawn"),
+    "columns": _gm(31, "a temple front: a row of repeated columns, steps"),
+    "colosseum": _gm(39, "Colosseum: tiers of repeated arches"),
+    "berlin": _gm(43, "Berlin cathedral: domes, columns, trees"),
+    "brick_church": _gm(44, "brick church with round-arched windows"),
+    "brandenburg": _gm(46, "Brandenburg Gate: columns, quadriga, a square"),
+    # animals in nature: texture, often on a defocused background
+    "rhino": _ge(0, "rhinoceros on a river bank: skin folds, smooth water and sky"),
+    "spoonbills": _ge(3, "spoonbills wading: smooth water, reflections"),
+    "kingfisher": _ge(8, "kingfisher on a branch: a defocused background"),
+    "gorilla": _ge(10, "gorilla in dense foliage"),
+    "gibbon": _ge(13, "gibbon in branches and leaves"),
+    "chameleon2": _ge(14, "chameleon on a branch among leaves"),
+    "crab": _ge(16, "crab on wet sand"),
+    "meerkats": _ge(17, "three meerkats: fur, a blurred background"),
+    "cheetah": _ge(20, "cheetah in dry grass"),
+    "pony": _ge(22, "pony on a hillside: mane, grass, mountains"),
+    "penguin": _ge(24, "penguin on gravel"),
+    "goat": _ge(29, "long-haired goat on rocks"),
+    "giraffe": _ge(31, "giraffe: a patched coat, trees"),
+}))
+
+# Pairs per image and setting (5 each: the test set has at least as many
+# photographs a group as the tuning set).
+PAIRS = {"tuning": 5, "test": 5}
 P_CYCLE = [10, 20, 30, 40, 60]      # groups a-d, g: pair i uses p = P_CYCLE[i % 5]
 CYCLE_PAIRS = 10                    # pairs per image in groups a-d, g (p cycles twice)
 
@@ -214,28 +265,38 @@ def still_groups(which):
     sd = TEST_SEEDS
     return {
         "few_edges": _scenes("few_edges", "B", sd[:9], "wall, floor line and a door")
-        + _scenes("few_edges", "A", sd[:4], "3-6 edges crossing flat regions (test seeds)"),
+        + _scenes("few_edges", "A", sd[:4], "3-6 edges crossing flat regions (test seeds)")
+        + [Item(T[k].why, photo=T[k]) for k in ("pyramid_dark", "pyramid_red", "camera")],
         "fog_dim": _scenes("fog_horizon", "B", sd[:5], "sea horizon in haze")
         + _scenes("dim_gradient", "B", sd[:4], "two dim planes meeting softly")
         + [Item("cliff and misty mountains, in fog", photo=T["cliff"], condition="fog"),
            Item("pagoda over a lake, in fog", photo=T["china"], condition="fog"),
-           Item("château, in fog", photo=T["castle"], condition="fog")],
+           Item("château, in fog", photo=T["castle"], condition="fog"),
+           Item(T["pyramid_haze"].why, photo=T["pyramid_haze"]),
+           Item("Mont-Saint-Michel, in fog", photo=T["st_michel"], condition="fog")],
         "low_light": [Item(f"{T[k].why}, in low light", photo=T[k], condition="lowlight")
                       for k in ("room", "station", "bridge", "ascent", "citrus", "flowers",
-                                "face", "tulips")]
+                                "face", "tulips", "india_gate", "cathedral")]
         + _scenes("few_edges", "B", sd[6:8], "few edges in low light", "lowlight")
         + _scenes("repeated", "B", sd[6:8], "repeated pattern in low light", "lowlight"),
-        "repeated": _scenes("repeated", "B", sd[:11], "bricks, windows or a chain-link fence")
-        + [Item(T["parrot"].why, photo=T["parrot"])],
+        "repeated": _scenes("repeated", "B", sd[:8], "bricks, windows or a chain-link fence")
+        + [Item(T[k].why, photo=T[k]) for k in ("parrot", "hawa_mahal", "aqueduct",
+                                                 "columns")],
         "line_rich": [Item(T[k].why, photo=T[k]) for k in
                       ("castle", "bridge", "china", "room", "station", "pantheon", "ascent",
-                       "camera", "parrot", "cliff")],
+                       "camera", "parrot", "cliff", "arena", "chambord", "cathedral",
+                       "carcassonne", "mysore", "victoria", "colosseum", "berlin",
+                       "brick_church", "brandenburg")],
         "decay": [Item(T[k].why, photo=T[k]) for k in
                   ("citrus", "bee", "chameleon", "dahlia", "flowers", "milla", "tulips",
-                   "branch", "aero", "face", "hopper")],
+                   "branch", "aero", "face", "hopper", "rhino", "gorilla", "gibbon",
+                   "chameleon2", "crab", "meerkats", "cheetah", "pony", "penguin", "goat",
+                   "giraffe")],
         "textureless": _scenes("textureless", "B", sd[:8], "cosine field and a soft shadow")
         + [Item("tulips, defocused to smooth shading", photo=T["tulips"], condition="defocus"),
-           Item("cliff and sea, defocused", photo=T["cliff"], condition="defocus")],
+           Item("cliff and sea, defocused", photo=T["cliff"], condition="defocus"),
+           Item("spoonbills on water, defocused", photo=T["spoonbills"], condition="defocus"),
+           Item("kingfisher, defocused", photo=T["kingfisher"], condition="defocus")],
     }
 
 

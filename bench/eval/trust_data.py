@@ -43,12 +43,20 @@ STATIC_CRF = 23
 
 
 class TrustLibrary(Library):
-    """data.Library plus the test set's formats: PyWavelets' .npz and SciPy's
-    face.dat (bz2-compressed raw 768x1024 RGB)."""
+    """data.Library plus the test set's formats: PyWavelets' .npz, SciPy's
+    face.dat (bz2-compressed raw 768x1024 RGB), and "FILE.rcc#K": the K-th WebP
+    image (in file order) stored in a Qt resource file (GCompris's data)."""
+
+    def fetch(self, photos):
+        from data import Photo
+        super().fetch([Photo(p.source, p.file.split("#")[0], p.why) for p in photos])
 
     def grey(self, photo):
         path = self.cache / "photos" / photo.source / photo.file
-        if path.suffix == ".npz":
+        if "#" in photo.file:
+            container, k = photo.file.split("#")
+            img = rcc_webp(self.cache / "photos" / photo.source / container, int(k))
+        elif path.suffix == ".npz":
             img = np.load(path)["data"].astype(np.float32)
         elif path.name == "face.dat":
             rgb = np.frombuffer(bz2.decompress(path.read_bytes()), np.uint8).reshape(768, 1024, 3)
@@ -59,6 +67,23 @@ class TrustLibrary(Library):
             x, y, w, h = photo.crop
             img = img[y:y + h, x:x + w]
         return img
+
+
+def rcc_webp(path, k):
+    """The k-th WebP image in a Qt .rcc resource file, grey float32.  rcc stores
+    already-compressed images as they are, so each is a whole RIFF/WEBP chunk."""
+    import re
+    import struct
+    data = Path(path).read_bytes()
+    for i, m in enumerate(re.finditer(rb"RIFF(....)WEBP", data, re.S)):
+        if i == k:
+            n = struct.unpack("<I", m.group(1))[0]
+            img = cv2.imdecode(np.frombuffer(data, np.uint8, 8 + n, m.start()),
+                               cv2.IMREAD_GRAYSCALE)
+            if img is None:
+                raise RuntimeError(f"{path}: WebP image {k} does not decode")
+            return img.astype(np.float32)
+    raise RuntimeError(f"{path} has no WebP image {k}")
 
 
 def world(lib, item, w, h):
