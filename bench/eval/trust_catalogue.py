@@ -213,7 +213,7 @@ T.update(_named({
 # photographs a group as the tuning set).
 PAIRS = {"tuning": 5, "test": 5}
 P_CYCLE = [10, 20, 30, 40, 60]      # groups a-d, g: pair i uses p = P_CYCLE[i % 5]
-CYCLE_PAIRS = 10                    # pairs per image in groups a-d, g (p cycles twice)
+CYCLE_PAIRS = 20                    # pairs per image in groups a-d, g (p cycles 4 times)
 
 GROUPS = [
     # (key, label, kind of settings)
@@ -308,13 +308,17 @@ def video_scenes(which):
     """[Item] the hand-held camera films, per set (each under every condition)."""
     if which == "tuning":
         return [Item("hotel facade and trees", photo=_tp("building_crop")),
+                Item("street of brick houses", photo=_tp("leuvenA")),
                 Item("gravel", photo=_tp("gravel")),
+                Item("painting: ornament texture", photo=_tp("Klimt")),
                 Item("notebook and elastic band", photo=_tp("ela_original")),
                 Item("apple: smooth shading", photo=APPLE),
                 Item("few edges on flat areas", scene=("few_edges", "A", "v0")),
                 Item("ridge in fog", scene=("fog_horizon", "A", "v0"))]
     return [Item(T["room"].why, photo=T["room"]),
+            Item(T["colosseum"].why, photo=T["colosseum"]),
             Item(T["bee"].why, photo=T["bee"]),
+            Item(T["cheetah"].why, photo=T["cheetah"]),
             Item(T["camera"].why, photo=T["camera"]),
             Item(T["cliff"].why, photo=T["cliff"]),
             Item("wall, floor line and a door", scene=("few_edges", "B", "v0")),
@@ -330,11 +334,15 @@ def static_clips(which):
                       photo=_tp("building_crop")), tex),
                 (Item("office wall and door frame (static), objects moving in front",
                       photo=_tp("basketball1")), tex),
+                (Item("aerial view of a town (static, dense texture), objects moving over it",
+                      photo=_tp("aero1")), tex),
                 (Item("flat wall with few edges (static), objects moving in front",
                       scene=("few_edges", "A", "static0")), tex)]
     tex = [T["citrus"], T["face"], T["bee"], T["aero"]]
     return [(Item("interior (static), objects moving in front", photo=T["room"]), tex),
             (Item("station hall (static), objects moving in front", photo=T["station"]), tex),
+            (Item("flower field (static, dense texture), objects moving in front",
+                  photo=T["flowers"]), tex),
             (Item("sea horizon in haze (static), objects moving in front",
                    scene=("fog_horizon", "B", "static0")), tex)]
 
