@@ -196,6 +196,9 @@ int home__homography_plausible(const double *h, int width, int height);
 typedef double (*home__normal_fn)(const void *user, const double *p, double *jtj, double *jte);
 int home__lm_solve(double *p, home__normal_fn fn, const void *user, int max_iters);
 int home__solve_spd8(double *a, double *b);
+/* The same in two steps, to solve for several right-hand sides with one factor. */
+int home__cholesky8(double *a);
+void home__cholesky_solve8(const double *l, double *b);
 
 /* line_fit.h: the homography's line fit over matched lines, one implementation compiled per
  * instruction set (the backend's table picks it); the same bits from each. */

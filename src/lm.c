@@ -8,9 +8,9 @@
 #define NP 8
 #define LM_MAX_TRIES 8
 
-/* Solve a x = b for symmetric positive definite a (8x8, row-major); a is overwritten by its
- * Cholesky factor and b by x. Returns 0 when a is not positive definite. */
-int home__solve_spd8(double *a, double *b)
+/* Cholesky factor of a symmetric positive definite 8x8 a (row-major), in place: the lower
+ * triangle becomes L with a = L L^T. Returns 0 when a is not positive definite. */
+int home__cholesky8(double *a)
 {
     int i, j, k;
     for (j = 0; j < NP; j++) {
@@ -25,16 +25,31 @@ int home__solve_spd8(double *a, double *b)
             a[i * NP + j] = s / d;
         }
     }
+    return 1;
+}
+
+/* b <- (L L^T)^-1 b for the factor home__cholesky8 left in l. */
+void home__cholesky_solve8(const double *l, double *b)
+{
+    int i, k;
     for (i = 0; i < NP; i++) {            /* L y = b */
         double s = b[i];
-        for (k = 0; k < i; k++) s -= a[i * NP + k] * b[k];
-        b[i] = s / a[i * NP + i];
+        for (k = 0; k < i; k++) s -= l[i * NP + k] * b[k];
+        b[i] = s / l[i * NP + i];
     }
     for (i = NP - 1; i >= 0; i--) {       /* L^T x = y */
         double s = b[i];
-        for (k = i + 1; k < NP; k++) s -= a[k * NP + i] * b[k];
-        b[i] = s / a[i * NP + i];
+        for (k = i + 1; k < NP; k++) s -= l[k * NP + i] * b[k];
+        b[i] = s / l[i * NP + i];
     }
+}
+
+/* Solve a x = b for symmetric positive definite a (8x8, row-major); a is overwritten by its
+ * Cholesky factor and b by x. Returns 0 when a is not positive definite. */
+int home__solve_spd8(double *a, double *b)
+{
+    if (!home__cholesky8(a)) return 0;
+    home__cholesky_solve8(a, b);
     return 1;
 }
 

@@ -137,17 +137,73 @@ static int to_h(int space, const double *p, double *hn)
     return home__inverse_transpose8(p, hn);
 }
 
+/* Predicted RMS corner error (px) of a model's estimate p with information n_mat = B^T F B:
+ * sqrt(mean over the corners of J_c B (B^T F B)^-1 B^T J_c^T); infinite when it cannot say. */
+static double model_sigma(const home__model_problem *mp, const double basis[8][8], int k,
+                          const double *n_mat, const double *p)
+{
+    double dh_dp[8][8], cj[8][8], hn[8], var = 0.0;
+    int i, j, c;
+    if (!to_h(mp->space, p, hn)) return INFINITY;
+    corner_jacobian(hn, mp->scale, mp->cx, mp->cy, cj);
+    if (mp->space == HOME__SPACE_G) {
+        /* d corner / d g = d corner / d h  d h / d g, the latter by central differences */
+        double p1[8], p2[8], h1[8], h2[8];
+        for (j = 0; j < 8; j++) {
+            const double eps = 1e-6;
+            memcpy(p1, p, sizeof p1);
+            memcpy(p2, p, sizeof p2);
+            p1[j] += eps;
+            p2[j] -= eps;
+            if (!home__inverse_transpose8(p1, h1) || !home__inverse_transpose8(p2, h2))
+                return INFINITY;
+            for (i = 0; i < 8; i++) dh_dp[i][j] = (h1[i] - h2[i]) / (2 * eps);
+        }
+        for (c = 0; c < 8; c++) {
+            double row[8];
+            for (j = 0; j < 8; j++) {
+                double s = 0.0;
+                for (i = 0; i < 8; i++) s += cj[c][i] * dh_dp[i][j];
+                row[j] = s;
+            }
+            memcpy(cj[c], row, sizeof row);
+        }
+    }
+    if (k > 0) {
+        double l[64];
+        memcpy(l, n_mat, sizeof l);
+        for (i = k; i < 8; i++) { /* padded to 8x8 with the identity, as home__solve_spd */
+            memset(l + i * 8, 0, 8 * sizeof *l);
+            l[i * 8 + i] = 1.0;
+        }
+        for (i = 0; i < k; i++) memset(l + i * 8 + k, 0, (size_t)(8 - k) * sizeof *l);
+        if (!home__cholesky8(l)) return INFINITY;
+        for (c = 0; c < 8; c++) {
+            double jq[8] = {0}, z[8], v = 0.0;
+            for (i = 0; i < k; i++) {
+                double s = 0.0;
+                for (j = 0; j < 8; j++) s += basis[i][j] * cj[c][j];
+                jq[i] = s;
+            }
+            memcpy(z, jq, sizeof z);
+            home__cholesky_solve8(l, z);
+            for (i = 0; i < k; i++) v += jq[i] * z[i];
+            var += v;
+        }
+    }
+    return sqrt(var / 4.0); /* RMS over the four corners of the 2-D error */
+}
+
 int home__select_model(const home__model_problem *mp, home__model_choice *out)
 {
-    double basis[8][8], o[8], dh_dp[8][8], cj[8][8], hn[8];
-    int model, i, j, c, best = -1;
+    double basis[8][8], o[8], best_basis[8][8], best_n[64], general_p[8];
+    int model, i, j, best = -1, best_k = 0, general = -1;
     double best_score = INFINITY;
-    home__model_choice trial, general;
 
     out->model = -1;
     out->sigma_px = INFINITY;
     for (model = HOME_MODEL_IDENTITY; model <= mp->max_model; model++) {
-        double n_mat[64] = {0}, rhs[8] = {0}, q[8], diff[8], fd[8], delta = 0.0, var = 0.0, score;
+        double n_mat[64] = {0}, rhs[8] = {0}, q[8], diff[8], fd[8], p[8], delta = 0.0, score;
         const int k = home__model_basis(mp->space, model, o, basis);
         if (k > mp->max_params) break;
         /* q = (B^T F B)^-1 B^T F (p - o) */
@@ -176,80 +232,46 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
             memcpy(q, rhs, sizeof q);
             if (k > 0 && !home__solve_spd(a_copy, q, k)) continue; /* not determined by the data */
         }
-        memcpy(trial.p, o, sizeof o);
+        memcpy(p, o, sizeof o);
         for (i = 0; i < k; i++)
-            for (j = 0; j < 8; j++) trial.p[j] += q[i] * basis[i][j];
-        for (i = 0; i < 8; i++) diff[i] = trial.p[i] - mp->p[i];
+            for (j = 0; j < 8; j++) p[j] += q[i] * basis[i][j];
+        for (i = 0; i < 8; i++) diff[i] = p[i] - mp->p[i];
         for (i = 0; i < 8; i++)
             for (j = 0; j < 8; j++) delta += diff[i] * mp->info[i * 8 + j] * diff[j];
         if (!isfinite(delta)) continue;
         score = delta + mp->penalty * k;
-        /* predicted corner covariance of the model's estimate: J_c B (B^T F B)^-1 B^T J_c^T */
-        if (!to_h(mp->space, trial.p, hn)) continue;
-        corner_jacobian(hn, mp->scale, mp->cx, mp->cy, cj);
-        if (mp->space == HOME__SPACE_G) {
-            /* d corner / d g = d corner / d h  d h / d g, the latter by central differences */
-            double p1[8], p2[8], h1[8], h2[8];
-            for (j = 0; j < 8; j++) {
-                const double eps = 1e-6;
-                memcpy(p1, trial.p, sizeof p1);
-                memcpy(p2, trial.p, sizeof p2);
-                p1[j] += eps;
-                p2[j] -= eps;
-                if (!home__inverse_transpose8(p1, h1) || !home__inverse_transpose8(p2, h2)) break;
-                for (i = 0; i < 8; i++) dh_dp[i][j] = (h1[i] - h2[i]) / (2 * eps);
-            }
-            if (j < 8) continue;
-            for (c = 0; c < 8; c++) {
-                double row[8];
-                for (j = 0; j < 8; j++) {
-                    double s = 0.0;
-                    for (i = 0; i < 8; i++) s += cj[c][i] * dh_dp[i][j];
-                    row[j] = s;
-                }
-                memcpy(cj[c], row, sizeof row);
-            }
-        }
-        for (c = 0; c < 8 && k > 0; c++) {
-            double jq[8], z[8], a_copy[64], v = 0.0;
-            for (i = 0; i < k; i++) {
-                double s = 0.0;
-                for (j = 0; j < 8; j++) s += basis[i][j] * cj[c][j];
-                jq[i] = s;
-            }
-            memcpy(a_copy, n_mat, sizeof a_copy);
-            memcpy(z, jq, sizeof z);
-            if (!home__solve_spd(a_copy, z, k)) { var = INFINITY; break; }
-            for (i = 0; i < k; i++) v += jq[i] * z[i];
-            var += v;
-        }
-        trial.model = model;
-        trial.delta = delta;
-        trial.sigma_px = sqrt(var / 4.0); /* RMS over the four corners of the 2-D error */
-        if (!isfinite(trial.sigma_px)) continue;
-        memcpy(&general, &trial, sizeof general); /* the most general determined model so far */
+        general = model; /* the most general determined model so far */
+        memcpy(general_p, p, sizeof general_p);
         if (score < best_score) {
             best_score = score;
             best = model;
-            *out = trial;
+            best_k = k;
+            memcpy(best_basis, basis, sizeof best_basis);
+            memcpy(best_n, n_mat, sizeof best_n);
+            memcpy(out->p, p, sizeof p);
+            out->model = model;
+            out->delta = delta;
         }
     }
-    /* a simpler model's error also holds its misfit: the RMS corner distance to the most
-     * general determined estimate (a static scene's identity is off by the motion it ignores) */
-    if (best >= 0 && general.model > out->model) {
-        double ha[8], hb[8], bias = 0.0;
-        if (to_h(mp->space, out->p, ha) && to_h(mp->space, general.p, hb)) {
-            bias = corner_rms_distance(ha, hb, mp);
-            out->sigma_px = sqrt(out->sigma_px * out->sigma_px + bias * bias);
-        }
-    }
+    if (best < 0) return 0;
     /* the chosen model must explain the data no worse than an exact homography would, at its
      * cost in parameters (matters when the homography is undetermined); a cap below the
      * homography asks for the best such model whatever its misfit */
-    if (best >= 0 && best < HOME_MODEL_HOMOGRAPHY && mp->max_model == HOME_MODEL_HOMOGRAPHY &&
-        !(out->delta <= mp->penalty * (8 - home__model_basis(mp->space, best, o, basis))))
+    if (best < HOME_MODEL_HOMOGRAPHY && mp->max_model == HOME_MODEL_HOMOGRAPHY &&
+        !(out->delta <= mp->penalty * (8 - best_k)))
         return 0;
-    return best >= 0;
+    out->sigma_px = model_sigma(mp, (const double (*)[8])best_basis, best_k, best_n, out->p);
+    if (!isfinite(out->sigma_px)) return 0;
+    /* a simpler model's error also holds its misfit: the RMS corner distance to the most
+     * general determined estimate (a static scene's identity is off by the motion it ignores) */
+    if (general > best) {
+        double ha[8], hb[8];
+        if (to_h(mp->space, out->p, ha) && to_h(mp->space, general_p, hb)) {
+            const double bias = corner_rms_distance(ha, hb, mp);
+            out->sigma_px = sqrt(out->sigma_px * out->sigma_px + bias * bias);
+        }
+    }
+    return 1;
 }
 
 const char *home_model_name(int model)

@@ -43,6 +43,7 @@
 #define STEP_EPS_PX 0.02    /* convergence: largest corner update, full-resolution px */
 #define STEP_NOISE_SHARE 0.25 /* ... or at the finest level, this share of the worst corner's
                                  predicted standard deviation */
+#define NOISE_CHECK_PX 0.5  /* (that prediction is made only for steps below this) */
 #define MAX_CORNER_STD_PX 0.5 /* worst corner's standard deviation (Fisher, or split-half) above
                                  this, or above max_sigma_px: ill conditioned */
 #define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
@@ -605,19 +606,33 @@ static double residual_variance(const solver *s)
 static double corner_std_px(const solver *s)
 {
     const double hu = s->cx / s->f, hv = s->cy / s->f;
-    double worst = 0.0;
-    int k, axis;
+    double worst = 0.0, l[64], g0[8] = {0};
+    int k, axis, i, j;
+    /* one factor of the (model's) normal matrix for the eight corner coordinates */
+    if (s->k == 8) {
+        memcpy(l, s->jtj, sizeof l);
+    } else {
+        double g[8] = {0};
+        home__project_normal(s->basis, s->k, s->jtj, g, l, g0);
+    }
+    if (!home__cholesky8(l)) return INFINITY;
     for (k = 0; k < 4; k++) {
         double u = (k & 1) ? hu : -hu, v = (k & 2) ? hv : -hv, var = 0.0;
         for (axis = 0; axis < 2; axis++) {
-            double jc[8], z[8], a[64], q = 0.0;
-            int i;
+            double jc[8], z[8], q = 0.0;
             memset(jc, 0, sizeof jc);
             if (axis == 0) { jc[0] = u; jc[1] = v; jc[2] = 1; jc[6] = -u * u; jc[7] = -u * v; }
             else { jc[3] = u; jc[4] = v; jc[5] = 1; jc[6] = -u * v; jc[7] = -v * v; }
-            memcpy(a, s->jtj, sizeof a);
-            memcpy(z, jc, sizeof z);
-            if (!model_solve(s, a, z)) return INFINITY;
+            if (s->k == 8) {
+                memcpy(z, jc, sizeof z);
+            } else { /* B^T jc, zero beyond k */
+                for (i = 0; i < 8; i++) {
+                    z[i] = 0.0;
+                    for (j = 0; j < 8 && i < s->k; j++) z[i] += s->basis[i][j] * jc[j];
+                }
+                memcpy(jc, z, sizeof jc);
+            }
+            home__cholesky_solve8(l, z);
             for (i = 0; i < 8; i++) q += jc[i] * z[i];
             var += q;
         }
@@ -714,7 +729,7 @@ static int choose_model(solver *s, int max_model, double *h1, home_result *resul
 {
     home__model_problem mp;
     home__model_choice choice;
-    double jac[8][8], hn[9];
+    double jac[8][8], t[8][8], hn[9];
     int i, j, a, b;
     mp.space = HOME__SPACE_H;
     for (j = 0; j < 8; j++) {
@@ -727,11 +742,16 @@ static int choose_model(solver *s, int max_model, double *h1, home_result *resul
         if (!update_between(s->hn, hp, dpp) || !update_between(s->hn, hm, dpm)) return 0;
         for (i = 0; i < 8; i++) jac[i][j] = (dpp[i] - dpm[i]) / (2 * eps);
     }
+    for (a = 0; a < 8; a++) /* t = J^T W J  d dp / d h, then d dp / d h^T t */
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (b = 0; b < 8; b++) v += s->jtj[a * 8 + b] * jac[b][j];
+            t[a][j] = v;
+        }
     for (i = 0; i < 8; i++)
         for (j = 0; j < 8; j++) {
             double v = 0.0;
-            for (a = 0; a < 8; a++)
-                for (b = 0; b < 8; b++) v += jac[a][i] * s->jtj[a * 8 + b] * jac[b][j];
+            for (a = 0; a < 8; a++) v += jac[a][i] * t[a][j];
             mp.info[i * 8 + j] = v / (s->resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE);
         }
     memcpy(mp.p, s->hn, sizeof mp.p);
@@ -757,6 +777,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     const home__refine_state *st = &ctx->refine;
     solver s;
     double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0, refined_std;
+    double noise_std = -1.0;
     int level, it, converged = 0, iterations = 0;
     float *scratch = (float *)st->scratch;
     const int cap = level_capacity(&ctx->cfg, st->finest_level);
@@ -801,9 +822,12 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
             if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
             /* at the finest level, also a step far below the estimate's own predicted
              * uncertainty: noisy frames (low light) keep the steps jittering at that scale */
-            if (level == s.finest) {
-                s.resid_var = residual_variance(&s);
-                if (step < STEP_NOISE_SHARE * corner_std_px(&s)) { converged = 1; break; }
+            if (level == s.finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
+                if (!(noise_std >= 0.0)) { /* predicted once, near the optimum */
+                    s.resid_var = residual_variance(&s);
+                    noise_std = corner_std_px(&s);
+                }
+                if (step < STEP_NOISE_SHARE * noise_std) { converged = 1; break; }
             }
             /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
             if (step > 0.5 * last_step) s.hessian_level = -1;
