@@ -221,8 +221,10 @@ enum home_refine_status {
                                      and 3x HOME's sigma_px, and cannot vouch for itself */
     HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
     HOME_REFINE_LOW_CORRELATION,  /* HOME failed and the refinement cannot vouch (rule below) */
-    HOME_REFINE_LESS_PRECISE      /* the refined H agrees with HOME's but predicts a larger
+    HOME_REFINE_LESS_PRECISE,     /* the refined H agrees with HOME's but predicts a larger
                                      error (sigma_px): HOME's H stays */
+    HOME_REFINE_STATIC            /* a small motion most of the frame's regions do not share
+                                     (moving objects): H is the identity */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */

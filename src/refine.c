@@ -49,6 +49,10 @@
 #define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
                                   (calibrated on the evaluation's tuning set: neighbouring
                                   template points do not carry independent noise) */
+#define REGIONS_X 8          /* the identity test's grid of regions (identity_region_share) */
+#define REGIONS_Y 6
+#define REGION_POINTS 3      /* a region with fewer template points does not vote */
+#define STATIC_SHARE 0.5     /* the identity replaces a small motion that wins fewer regions */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SHARE 0.9      /* ... and, against HOME's estimate or with none, with this share
                                 of its points within 3 robust sigmas */
@@ -770,6 +774,80 @@ static int choose_model(solver *s, int max_model, double *h1, home_result *resul
     return 1;
 }
 
+/* A solver on the template of slot `slot`, its scratch, the normalisation and the level the
+ * estimate ends at. */
+static void solver_setup(home_context *ctx, int slot, solver *s)
+{
+    const home__refine_state *st = &ctx->refine;
+    float *scratch = (float *)st->scratch;
+    const int cap = level_capacity(&ctx->cfg, st->finest_level);
+    memset(s, 0, sizeof *s);
+    s->st = st;
+    s->tpl = st->tpl[slot];
+    s->cx = 0.5 * (ctx->cfg.width - 1);
+    s->cy = 0.5 * (ctx->cfg.height - 1);
+    s->f = 0.5 * (ctx->cfg.width > ctx->cfg.height ? ctx->cfg.width : ctx->cfg.height);
+    s->img_b = scratch;
+    s->img_b2 = scratch + cap;
+    s->res = scratch + 2 * cap;
+    s->wt = scratch + 3 * cap;
+    s->alpha = 1.0;
+    s->hessian_level = -1;
+    s->k = 8;
+    for (s->finest = st->finest_level; s->finest < st->levels - 1; s->finest++)
+        if (s->tpl[s->finest].n >= FINEST_MIN_POINTS) break;
+}
+
+/* Share of the frame's regions (a REGIONS_X x REGIONS_Y grid; those with at least REGION_POINTS
+ * template points vote) whose points the identity explains better than h (pixels) does: the
+ * robust photometric cost of each region under both, gain and bias fitted to each. Moving
+ * objects are textured and draw the template points (and HOME's lines) to themselves; the
+ * static background wins by area. */
+static double identity_region_share(home_context *ctx, int slot, const double *h)
+{
+    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const home__refine_state *st = &ctx->refine;
+    double cost[2][REGIONS_X * REGIONS_Y], hn[9], sigma, c;
+    int count[REGIONS_X * REGIONS_Y], e, i, r, votes = 0, wins = 0, fl, n4;
+    const home__refine_points *tp;
+    float m[9];
+    solver s;
+    solver_setup(ctx, slot, &s);
+    fl = s.finest;
+    tp = &s.tpl[fl];
+    if (tp->n < MIN_POINTS) return 0.0;
+    n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    to_normalised(&s, h, hn);
+    level_matrix(&s, hn, fl, m);
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
+    level_matrix(&s, identity, fl, m);
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
+    /* one scale for both: the estimate's residuals (the identity's would let it excuse itself) */
+    fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
+    sigma = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta, (int32_t *)(void *)s.wt);
+    c = CAUCHY_K * sigma;
+    memset(cost, 0, sizeof cost);
+    memset(count, 0, sizeof count);
+    for (e = 0; e < 2; e++) {
+        const float *img = e ? s.img_b2 : s.img_b;
+        s.alpha = 1.0;
+        s.beta = 0.0;
+        for (i = 0; i < 2; i++) fit_photometric(&s, tp, img, e ? s.img_b : s.img_b2, sigma, s.res, s.wt);
+        for (i = 0; i < tp->n; i++) {
+            if (s.img_b[i] < 0.0f || s.img_b2[i] < 0.0f) continue;
+            r = (tp->y[i] * REGIONS_Y / st->h[fl]) * REGIONS_X + tp->x[i] * REGIONS_X / st->w[fl];
+            cost[e][r] += robust_cost(s.res[i], c);
+            count[r] += !e;
+        }
+    }
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
+        if (count[r] < REGION_POINTS) continue;
+        votes++;
+        wins += cost[1][r] < cost[0][r];
+    }
+    return votes >= REGIONS_X * REGIONS_Y / 4 ? (double)wins / votes : 0.0;
+}
+
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid.
  * Writes the refined H and fills the refine fields of result. */
 static void refine(home_context *ctx, int slot, const double *h0, home_result *result)
@@ -779,22 +857,9 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0, refined_std;
     double noise_std = -1.0;
     int level, it, converged = 0, iterations = 0;
-    float *scratch = (float *)st->scratch;
-    const int cap = level_capacity(&ctx->cfg, st->finest_level);
     const double max_std = MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
 
-    memset(&s, 0, sizeof s);
-    s.st = st;
-    s.tpl = st->tpl[slot];
-    s.cx = 0.5 * (ctx->cfg.width - 1);
-    s.cy = 0.5 * (ctx->cfg.height - 1);
-    s.f = 0.5 * (ctx->cfg.width > ctx->cfg.height ? ctx->cfg.width : ctx->cfg.height);
-    s.img_b = scratch;
-    s.img_b2 = scratch + cap;
-    s.res = scratch + 2 * cap;
-    s.wt = scratch + 3 * cap;
-    s.alpha = 1.0;
-    s.hessian_level = -1;
+    solver_setup(ctx, slot, &s);
     /* below a homography the update stays in the model (it is a group: I + D(dp) in it keeps
      * the estimate in it), so a few edges that leave a homography undetermined still fix it */
     s.k = 8;
@@ -804,8 +869,6 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     }
     to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
-    for (s.finest = st->finest_level; s.finest < st->levels - 1; s.finest++)
-        if (s.tpl[s.finest].n >= FINEST_MIN_POINTS) break;
     for (level = s.finest; level < st->levels; level++) {
         if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return; }
     }
@@ -974,6 +1037,17 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
          * tuning set nearly every such estimate was more than 2 px off */
         trial.ok = 0;
         trial.failure = HOME_FAIL_INCONSISTENT;
+    }
+    /* a small motion the static background does not share is the moving objects' */
+    if ((trial.ok || has_estimate) && trial.model != HOME_MODEL_IDENTITY &&
+        corner_distance(ctx, trial.H, identity) <= ctx->cfg.refine_trust_px * ctx->hough_scale &&
+        identity_region_share(ctx, slot, trial.H) >= STATIC_SHARE) {
+        memcpy(trial.H, identity, sizeof trial.H);
+        trial.model = HOME_MODEL_IDENTITY;
+        if (!(trial.sigma_px <= ctx->cfg.max_sigma_px)) trial.sigma_px = ctx->cfg.max_sigma_px;
+        trial.ok = 1;
+        trial.failure = HOME_FAIL_NONE;
+        trial.refine_status = HOME_REFINE_STATIC;
     }
     *result = trial;
     result->ms[HOME_STAGE_REFINE] += home__now(ctx) - t0;
