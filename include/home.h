@@ -267,13 +267,15 @@ typedef struct home_result {
  * Failure rule with refinement: HOME's estimate (ok, or short of inliers or certainty with at
  * least 8 inliers) is refined. An accepted refinement within max(refine_trust_px, 3 sigma_px)
  * of HOME's H agrees with it: the result is the refined H, ok when HOME's was, or when the
- * photometric fit vouches for it (refine_zncc >= 0.9). Farther away the two disagree: the
- * refined H is the result only when it vouches for the whole frame (refine_zncc >= 0.9 and
- * refine_inlier_share >= 0.9), else the pair fails (HOME_FAIL_INCONSISTENT). A refinement that
+ * photometric fit vouches for it (refine_zncc >= 0.9 and sigma_px <= 0.4 max_sigma_px).
+ * Farther away the two disagree: the refined H is the result only when it vouches for the whole
+ * frame (also refine_inlier_share >= 0.9), else the pair fails (HOME_FAIL_INCONSISTENT). A refinement that
  * cannot converge although the frame has texture refutes HOME's estimate (INCONSISTENT too);
  * one declined for another reason leaves HOME's H, sigma and ok. When HOME finds no estimate,
  * direct alignment from the identity is tried; it vouches like an overruling refinement and
- * must stay within refine_trust_px of the identity. */
+ * must stay within refine_trust_px of the identity. A small motion (within refine_trust_px of
+ * the identity) that most of the frame's regions explain worse than the identity does is the
+ * moving objects': H becomes the identity (HOME_REFINE_STATIC). */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 
