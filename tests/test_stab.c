@@ -730,11 +730,49 @@ static void test_api_contract(void)
     CHECK_EQ_INT(home_stab_flush(st, &o), HOME_E_STATE);
 }
 
+/* A static camera with a textured object crossing a fifth of the frame: the object must not
+ * steer the path: every registration is the identity or refused, and the raw path stays 0. */
+static void test_static_camera_moving_object(void)
+{
+    static uint8_t frame[CW * CH * 3 / 2];
+    static const double still[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    home_stab *st = make_stab(4, 1, 0);
+    home_stab_output o;
+    home_stab_image im;
+    double worst = 0.0;
+    int t, x, y, identities = 0, moved = 0, n = 0;
+    CHECK(st != NULL);
+    if (!st) return;
+    for (t = 0; t < 40; t++) {
+        synth_render(SYNTH_STRUCTURED, 9, still, 2.5, (uint64_t)t + 100, frame, CW, CH, CW);
+        memset(frame + CW * CH, 128, CW * CH / 2);
+        for (y = 40; y < 40 + 56; y++) /* a 90x56 checkered object moving 3 px a frame */
+            for (x = 10 + 3 * t; x < 10 + 3 * t + 90 && x < CW; x++)
+                frame[y * CW + x] = (uint8_t)(((x - 3 * t) / 6 + y / 5) % 2 ? 200 : 40);
+        grey_image(frame, &im);
+        CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_OK);
+        if (t > 0) {
+            n++;
+            identities += o.reg.ok && o.reg.model == HOME_MODEL_IDENTITY;
+            moved += o.reg.ok && o.reg.model != HOME_MODEL_IDENTITY;
+        }
+        if (o.ready) {
+            const double d = fabs(o.raw.tx) + fabs(o.raw.ty) + fabs(o.raw.angle) * CW;
+            if (d > worst) worst = d;
+        }
+    }
+    printf("    %d of %d registrations the identity, %d a motion (the rest refused), largest raw "
+           "path excursion %.4f px\n", identities, n, moved, worst);
+    CHECK_EQ_INT(moved, 0);
+    CHECK(4 * identities >= 3 * n);
+    CHECK_LT(worst, 0.05);
+}
+
 #define STAB_TESTS(X) \
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
     X(warp_formats_agree) X(warp_bands_match_whole) X(warp_backends_identical) X(warp_plane_end) X(jitter_reduced_causal) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
-    X(deterministic)
+    X(deterministic) X(static_camera_moving_object)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
 
