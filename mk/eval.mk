@@ -1,11 +1,13 @@
 # Evaluation against ORB, AKAZE and LSD/LBD on real photographs (bench/eval, Python 3).
 #   make eval        full run: regenerates bench/eval/results.md and its plots
 #   make eval-quick  the CI subset: report in $(EVAL_CACHE)/quick/results.md
-#   make eval-trust        issue 16: can `ok` be trusted? tuning set vs sealed test set, still
-#                          pairs, consecutive frames, static camera; rewrites
-#                          bench/eval/trust_results.md, trust_results.json.gz and trust_*.png
-#   make eval-trust-quick  its CI subset (report in $(EVAL_CACHE)/trust-quick/; fails only when
-#                          the harness breaks, never on the numbers)
+#   make eval-trust        issue 16: can `ok` be trusted? tuning set vs test set, still
+#                          pairs, consecutive frames, static camera, and the sealed set's
+#                          static clips; rewrites bench/eval/trust_results.md,
+#                          trust_results.json.gz and trust_*.png
+#   make eval-trust-quick  its CI subset, tuning and test sets only (report in
+#                          $(EVAL_CACHE)/trust-quick/; fails only when the harness breaks,
+#                          never on the numbers)
 # Photographs come from Debian packages (apt-get download) into $(EVAL_CACHE).
 EVAL_CACHE ?= $(BUILD)/eval-cache
 EVAL_JOBS ?= 2
@@ -26,7 +28,8 @@ eval: $(BUILD)/bin/home-register eval-deps
 eval-quick: $(BUILD)/bin/home-register eval-deps
 	$(EVAL_RUN) --quick
 
-# EVAL_TRUST_ARGS: more trust.py options, e.g. --sets test --suites static, or
+# EVAL_TRUST_ARGS: more trust.py options, e.g. --sets test --suites static (sets: tuning,
+#   test, sealed; sealed has static clips only), or
 #   --extra-args "--refine-trust 40" (passed to every home-register run)
 EVAL_TRUST_ARGS ?=
 EVAL_TRUST = $(EVAL_PYTHON) bench/eval/trust.py --home $(BUILD)/bin/home-register \

@@ -5,7 +5,10 @@
   python3 bench/eval/trust.py --quick          # CI subset: build/eval-cache/trust-quick/
   python3 bench/eval/trust.py --sets test --suites static --home build-x/bin/home-register
 
-Three suites, each on both sets (trust_catalogue.py says what is in them):
+Three sets: tuning, test and sealed (static clips only, kept for a final check
+after the test set's static clips were looked at; the full run includes it,
+--quick leaves it out unless --sets names it).
+Three suites, on the tuning and test sets (trust_catalogue.py says what is in them):
   pairs   the paper's still-pair protocol on photographs and rendered hard
           scenes, in groups a-g (few edges, fog / dim, low light, repeated
           patterns, line-rich p = 10..60, texture decay alpha = 0..0.95, textureless)
@@ -198,7 +201,9 @@ def main():
     ap.add_argument("--home", default=str(REPO / "build/bin/home-register"))
     ap.add_argument("--stab", default=None, help="home-stab (default: beside --home)")
     ap.add_argument("--extra-args", default="", help="more home-register options, one string")
-    ap.add_argument("--sets", default="tuning,test")
+    ap.add_argument("--sets", default=None,
+                    help="comma-separated, from " + ",".join(catalogue.SETS) + " (default "
+                    "all; --quick: tuning,test); the sealed set has static clips only")
     ap.add_argument("--suites", default="pairs,video,static")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="the CI subset")
@@ -220,6 +225,9 @@ def main():
     cache = Path(args.cache).resolve()
     out = Path(args.out) if args.out else (cache / "trust-quick" if args.quick else HERE)
     out.mkdir(parents=True, exist_ok=True)
+    if args.sets is None:
+        args.sets = ",".join(s for s in catalogue.SETS
+                             if not (args.quick and s in catalogue.STATIC_ONLY))
     sets = [s for s in args.sets.split(",") if s]
     suites = [s for s in args.suites.split(",") if s]
     bad = [s for s in sets if s not in catalogue.SETS] + \
@@ -251,6 +259,8 @@ def main():
     records, clips, timing = [], [], {}
     for s in sets:
         for suite in suites:
+            if s in catalogue.STATIC_ONLY and suite != "static":
+                continue                           # the sealed set has clips only
             t0 = time.perf_counter()
             if suite == "pairs":
                 recs = trust_data.build_pairs(lib, s, args.quick, root, catalogue, args.jobs)

@@ -1,4 +1,4 @@
-"""The trust evaluation's two sets: what each image is, where it comes from, why.
+"""The trust evaluation's three sets: what each image is, where it comes from, why.
 
 TUNING: the 40 catalogue photographs of `make eval` (opencv-doc, python3-skimage,
 visp-images-data: the photographs the library's thresholds were chosen on) and
@@ -19,6 +19,16 @@ other seeds).  Sources of the test photographs:
   gcompris-qt-data     GCompris's activities: monuments (explore_monuments.rcc, 1024 px)
                        and animals in nature (erase.rcc, 1920x1080); "FILE.rcc#K" is the
                        K-th WebP image in the Qt resource file (see trust_data.rcc_webp)
+
+SEALED (static camera only; never look at its numbers while choosing anything):
+the test set's static clips were looked at while two thresholds were chosen, so
+a third set holds static clips whose backgrounds and mover textures are
+photographs no other set uses anywhere (other images of the test set's
+packages: GCompris's explore_world_music.rcc, clickgame.rcc (underwater
+photographs), erase.rcc, explore_monuments.rcc, explore_world_animals.rcc and
+explore_farm_animals.rcc; Hugin's manual), with other seeds (a salt) and a
+wider moving share.  `--sets sealed` selects it; it has no still pairs and no
+hand-held frames.
 
 Reserved for independent checks and never used here: Debian's desktop wallpaper
 and background packages (desktop-base, *-backgrounds, *-wallpapers),
@@ -69,7 +79,8 @@ TEST_LICENCES = {
 PACKAGES.update(TEST_PACKAGES)
 LICENCES.update(TEST_LICENCES)
 
-SETS = ["tuning", "test"]
+SETS = ["tuning", "test", "sealed"]
+STATIC_ONLY = {"sealed"}            # sets with static clips only
 
 
 @dataclass(frozen=True)
@@ -262,6 +273,8 @@ def still_groups(which):
             + [Item("apple: smooth shading", photo=APPLE),
                Item("lunar surface", photo=MOON)],
         }
+    if which == "sealed":
+        return {}
     sd = TEST_SEEDS
     return {
         "few_edges": _scenes("few_edges", "B", sd[:9], "wall, floor line and a door")
@@ -315,6 +328,8 @@ def video_scenes(which):
                 Item("apple: smooth shading", photo=APPLE),
                 Item("few edges on flat areas", scene=("few_edges", "A", "v0")),
                 Item("ridge in fog", scene=("fog_horizon", "A", "v0"))]
+    if which == "sealed":
+        return []
     return [Item(T["room"].why, photo=T["room"]),
             Item(T["colosseum"].why, photo=T["colosseum"]),
             Item(T["bee"].why, photo=T["bee"]),
@@ -326,6 +341,43 @@ def video_scenes(which):
 
 
 # -- static camera, moving objects --------------------------------------------
+# The sealed set's photographs: used by no other set, in no suite (checked below).
+def _gw(k, why):
+    return Photo("gcompris", f"explore_world_music.rcc#{k}", why)
+
+
+SEALED = _named({
+    # backgrounds
+    "orchestra": _gw(0, "symphony orchestra on a concert-hall stage: chairs, stands, "
+                        "panelled walls (indoor)"),
+    "drums": _gw(6, "drum kit and guitar against a plain wall, cables on a carpet "
+                    "(indoor, few edges)"),
+    "lute": _gw(2, "a long-necked lute on a plain grey studio backdrop (plain, indoor)"),
+    "sea_haze": Photo("gcompris", "clickgame.rcc#11",
+                      "sea floor in underwater haze: low contrast, smooth gradients (hazy)"),
+    "camels": _ge(5, "camels on a flat steppe under a pale sky (plain: large flat areas)"),
+    "sun_temple": _gm(19, "carved walls of a sun temple along a passage: dense relief, "
+                          "long lines"),
+    "office_block": Photo("hugin", "CA_tCA00.jpg",
+                          "office block over a lawn: a grid of windows, flat grass"),
+    # textures of the moving objects
+    "jaguars": Photo("gcompris", "explore_world_animals.rcc#12",
+                     "two jaguars on rocks: spotted fur"),
+    "hedgehog": Photo("gcompris", "explore_world_animals.rcc#4", "hedgehog in grass: spines"),
+    "komodo": Photo("gcompris", "explore_world_animals.rcc#8",
+                    "Komodo dragon on rock: scales"),
+    "sheep": Photo("gcompris", "explore_farm_animals.rcc#2", "sheep on a pasture: wool, grass"),
+})
+
+# Objects of the static clips: their areas add up to a share drawn from this
+# range (per set), and the object seeds are salted per set.
+STATIC_COVER = {"tuning": (0.15, 0.25), "test": (0.15, 0.25), "sealed": (0.13, 0.26)}
+STATIC_SALT = {"tuning": "", "test": "", "sealed": "|sealed-1"}
+# ... and a draw is kept only when the share of the frame the objects actually
+# change (at most, every 25th frame) lies in this range; else it is redrawn
+STATIC_SHARE = (0.10, 0.30)
+
+
 def static_clips(which):
     """[(background Item, [Photo] textures of the moving objects)]."""
     if which == "tuning":
@@ -337,7 +389,18 @@ def static_clips(which):
                 (Item("aerial view of a town (static, dense texture), objects moving over it",
                       photo=_tp("aero1")), tex),
                 (Item("flat wall with few edges (static), objects moving in front",
-                      scene=("few_edges", "A", "static0")), tex)]
+                      scene=("few_edges", "A", "static0")), tex),
+                # added later for more tuning data (after the first four were used)
+                (Item("white table, a cube and a cylinder (static, plain, indoor), objects "
+                      "moving in front", photo=_tp("image0000")), tex),
+                (Item("ornate building in fog (static, hazy), objects moving in front",
+                      photo=_tp("home"), condition="fog"), tex)]
+    if which == "sealed":
+        S = SEALED
+        tex = [S["jaguars"], S["hedgehog"], S["komodo"], S["sheep"]]
+        return [(Item(f"{S[k].why}; static, objects moving in front", photo=S[k]), tex)
+                for k in ("orchestra", "sea_haze", "office_block", "drums", "camels",
+                          "sun_temple", "lute")]
     tex = [T["citrus"], T["face"], T["bee"], T["aero"]]
     return [(Item("interior (static), objects moving in front", photo=T["room"]), tex),
             (Item("station hall (static), objects moving in front", photo=T["station"]), tex),
@@ -366,6 +429,30 @@ def _check_names():
                     key = it.photo.name + str(it.photo.crop)
                     f = (it.photo.source, it.photo.file)
                     assert files.setdefault(key, f) == f, (key, f, files[key])
+    # static clips: names unique over all sets (they are the report's rows)
+    clips = [bg.name for s in SETS for bg, _ in static_clips(s)]
+    assert len(clips) == len(set(clips)), clips
+
+
+def _photos(which):
+    """Every photograph a set uses, in any suite, as (package source, file)."""
+    out = {(it.photo.source, it.photo.file) for its in still_groups(which).values()
+           for it in its if it.photo}
+    out |= {(it.photo.source, it.photo.file) for it in video_scenes(which) if it.photo}
+    for bg, tex in static_clips(which):
+        out |= {(p.source, p.file) for p in tex}
+        if bg.photo:
+            out.add((bg.photo.source, bg.photo.file))
+    return out
+
+
+def _check_sealed():
+    """The sealed set shares no photograph with the other sets, and has clips only."""
+    others = set().union(*(_photos(s) for s in SETS if s != "sealed"))
+    assert not (_photos("sealed") & others), _photos("sealed") & others
+    for s in STATIC_ONLY:
+        assert not still_groups(s) and not video_scenes(s)
 
 
 _check_names()
+_check_sealed()
