@@ -1,9 +1,11 @@
 /* libhome live electronic image stabilisation (home_stab_*).
  *
  * Per frame the stabiliser registers the frame's (optionally downscaled) luma to the previous
- * frame with HOME, reusing the previous frame's features; fits a similarity (translation,
- * rotation, zoom about the image centre) to HOME's homography; accumulates the camera path;
- * smooths it with a constant-velocity Kalman filter and, with a lookahead of N frames, a
+ * frame with HOME, reusing the previous frame's features and asking it for a similarity
+ * (home_config.max_model), which it fits as a similarity (translation, rotation, zoom about the
+ * image centre); accumulates the camera path; smooths it with a constant-velocity Kalman filter
+ * (each frame's measurement noise grows with the registration's predicted error sigma_px, so an
+ * uncertain motion pulls the path less; a static scene registers as exactly no motion) and, with a lookahead of N frames, a
  * fixed-lag Rauch-Tung-Striebel smoother over those N frames; and returns the warp that shows
  * the smoothed camera through a crop window (margin m on each side, scaled to fill the frame).
  * The correction is shrunk towards identity whenever the window would leave the frame, so the
