@@ -390,7 +390,7 @@ static void to_normalised(const solver *s, const double *h, double *hn)
 {
     const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
     const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
-    double t[9];
+    double t[9] = {0}; /* all written by mat3_mul; zeroed for gcc's -fanalyzer (make lint) */
     mat3_mul(n, h, t);
     mat3_mul(t, ni, hn);
     normalise9(hn);
@@ -400,7 +400,7 @@ static void to_pixels(const solver *s, const double *hn, double *h)
 {
     const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
     const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
-    double t[9];
+    double t[9] = {0}; /* all written by mat3_mul; zeroed for gcc's -fanalyzer (make lint) */
     mat3_mul(ni, hn, t);
     mat3_mul(t, n, h);
     normalise9(h);
@@ -699,9 +699,9 @@ static double inlier_share(solver *s, const float *img_b, const float *other_b)
     return n ? (double)in / n : 0.0;
 }
 
-static double max_corner_distance(const solver *s, const double *h1, const double *h2)
+static double max_corner_distance(double cx, double cy, const double *h1, const double *h2)
 {
-    const double xs[2] = {0.0, 2.0 * s->cx}, ys[2] = {0.0, 2.0 * s->cy};
+    const double xs[2] = {0.0, 2.0 * cx}, ys[2] = {0.0, 2.0 * cy};
     double worst = 0.0;
     int k;
     for (k = 0; k < 4; k++) {
@@ -940,7 +940,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
     result->refine_zncc = zncc1;
     /* not lower: a divergence, or (noisy frames) the start was already the optimum within the
      * refined estimate's own uncertainty, which then stands */
-    if (!(e1 < e0) && !(max_corner_distance(&s, h1, h0) <= 3.0 * refined_std)) {
+    if (!(e1 < e0) && !(max_corner_distance(s.cx, s.cy, h1, h0) <= 3.0 * refined_std)) {
         result->refine_status = HOME_REFINE_NOT_LOWER;
         return;
     }
@@ -956,10 +956,7 @@ static void refine(home_context *ctx, int slot, const double *h0, home_result *r
 /* Largest distance of the image corners under two pixel homographies (NaN: infinitely far). */
 static double corner_distance(const home_context *ctx, const double *h1, const double *h2)
 {
-    solver s;
-    s.cx = 0.5 * (ctx->cfg.width - 1);
-    s.cy = 0.5 * (ctx->cfg.height - 1);
-    return max_corner_distance(&s, h1, h2);
+    return max_corner_distance(0.5 * (ctx->cfg.width - 1), 0.5 * (ctx->cfg.height - 1), h1, h2);
 }
 
 static int find_slot(const home__refine_state *st, uint32_t id)
