@@ -21,9 +21,11 @@
  * Safeguards (result.refine_status): the refined H replaces HOME's only if that finest level
  * converged within its cap, the estimate is well conditioned (the corners' standard deviation
  * predicted by the Fisher information, and the disagreement of two interleaved halves of the
- * points, which also sees noise in the template's own gradients, both under 0.5 px), no corner
- * moved more than refine_trust_px (times hough_downscale), and the robust photometric error over the points both
- * warps keep went down. Otherwise HOME's H stays. Noise-only templates never converge.
+ * points, which also sees noise in the template's own gradients, both under max(0.5 px,
+ * max_sigma_px)), and the robust photometric error over the points both warps keep went down.
+ * The refined estimate then goes through model selection (src/model.c), which gives its
+ * sigma_px; home__refine_apply() weighs it against HOME's (the rule in home.h at home_match).
+ * Noise-only templates never converge.
  *
  * Coordinates: normalised u = (x - cx) / f, v = (y - cy) / f with cx, cy the image centre and
  * f half the longer side, so the 8 parameters are O(1) at every level. Level l pixel x_l sits at
@@ -614,14 +616,15 @@ static double residual_variance(const solver *s)
 static double corner_std_px(const solver *s)
 {
     const double hu = s->cx / s->f, hv = s->cy / s->f;
-    double worst = 0.0, l[64], g0[8] = {0};
+    double worst = 0.0, l[64];
     int k, axis, i, j;
     /* one factor of the (model's) normal matrix for the eight corner coordinates */
     if (s->k == 8) {
         memcpy(l, s->jtj, sizeof l);
     } else {
-        double g[8] = {0};
-        home__project_normal(s->basis, s->k, s->jtj, g, l, g0);
+        const double no_gradient[8] = {0};
+        double unused[8];
+        home__project_normal(s->basis, s->k, s->jtj, no_gradient, l, unused);
     }
     if (!home__cholesky8(l)) return INFINITY;
     for (k = 0; k < 4; k++) {
