@@ -214,9 +214,10 @@ enum home_refine_status {
                                      is not the last one (see home_match) */
     HOME_REFINE_FEW_POINTS,       /* too little texture: fewer than 64 usable template points */
     HOME_REFINE_NOT_CONVERGED,    /* the finest level used hit refine_iterations */
-    HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above 0.5 px (predicted, or from
-                                     two interleaved halves of the points), or the refined H
-                                     fails HOME_FAIL_DEGENERATE's plausibility rule */
+    HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above max(0.5 px, max_sigma_px)
+                                     (predicted, or from two interleaved halves of the points),
+                                     no model determined, or the refined H fails
+                                     HOME_FAIL_DEGENERATE's plausibility rule */
     HOME_REFINE_OUTSIDE_TRUST,    /* the refined H is farther from HOME's than refine_trust_px
                                      and 3x HOME's sigma_px, and cannot vouch for itself */
     HOME_REFINE_NOT_LOWER,        /* the photometric error did not go down */
@@ -268,14 +269,15 @@ typedef struct home_result {
  * least 8 inliers) is refined. An accepted refinement within max(refine_trust_px, 3 sigma_px)
  * of HOME's H agrees with it: the result is the refined H, ok when HOME's was, or when the
  * photometric fit vouches for it (refine_zncc >= 0.9 and sigma_px <= 0.4 max_sigma_px).
- * Farther away the two disagree: the refined H is the result only when it vouches for the whole
- * frame (also refine_inlier_share >= 0.9), else the pair fails (HOME_FAIL_INCONSISTENT). A refinement that
- * cannot converge although the frame has texture refutes HOME's estimate (INCONSISTENT too);
- * one declined for another reason leaves HOME's H, sigma and ok. When HOME finds no estimate,
- * direct alignment from the identity is tried; it vouches like an overruling refinement and
- * must stay within refine_trust_px of the identity. A small motion (within refine_trust_px of
- * the identity) that most of the frame's regions explain worse than the identity does is the
- * moving objects': H becomes the identity (HOME_REFINE_STATIC). */
+ * Farther away the two disagree: the refined H is the result only when it vouches for the
+ * whole frame (also refine_inlier_share >= 0.9), else the pair fails (HOME_FAIL_INCONSISTENT).
+ * A refinement that cannot converge although the frame has texture refutes HOME's estimate
+ * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
+ * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the
+ * identity is tried; it vouches like an overruling refinement and must stay within
+ * refine_trust_px of the identity. An ok small motion (within refine_trust_px of the identity)
+ * that most of the frame's regions explain worse than the identity does is the moving
+ * objects': H becomes the identity (HOME_REFINE_STATIC). */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 
