@@ -20,15 +20,22 @@
 #include <string.h>
 
 /* Solve a x = b (k x k SPD, row stride 8) by padding to the 8x8 solver; a is overwritten. */
-int home__solve_spd(double *a, double *b, int k)
+/* The leading k x k block of a (row stride 8) padded to 8x8 with the identity. */
+static void pad_identity(double *a, int k)
 {
     int i;
     for (i = k; i < 8; i++) {
         memset(a + i * 8, 0, 8 * sizeof *a);
         a[i * 8 + i] = 1.0;
-        b[i] = 0.0;
     }
     for (i = 0; i < k; i++) memset(a + i * 8 + k, 0, (size_t)(8 - k) * sizeof *a);
+}
+
+int home__solve_spd(double *a, double *b, int k)
+{
+    int i;
+    pad_identity(a, k);
+    for (i = k; i < 8; i++) b[i] = 0.0;
     return home__solve_spd8(a, b);
 }
 
@@ -172,11 +179,7 @@ static double model_sigma(const home__model_problem *mp, const double basis[8][8
     if (k > 0) {
         double l[64];
         memcpy(l, n_mat, sizeof l);
-        for (i = k; i < 8; i++) { /* padded to 8x8 with the identity, as home__solve_spd */
-            memset(l + i * 8, 0, 8 * sizeof *l);
-            l[i * 8 + i] = 1.0;
-        }
-        for (i = 0; i < k; i++) memset(l + i * 8 + k, 0, (size_t)(8 - k) * sizeof *l);
+        pad_identity(l, k);
         if (!home__cholesky8(l)) return INFINITY;
         for (c = 0; c < 8; c++) {
             double jq[8] = {0}, z[8], v = 0.0;

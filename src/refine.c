@@ -781,6 +781,8 @@ static int choose_model(solver *s, int max_model, double *h1, home_result *resul
     return 1;
 }
 
+static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
 /* A solver on the template of slot `slot`, its scratch, the normalisation and the level the
  * estimate ends at. */
 static void solver_setup(home_context *ctx, int slot, solver *s)
@@ -812,7 +814,6 @@ static void solver_setup(home_context *ctx, int slot, solver *s)
  * static background wins by area. */
 static double identity_region_share(home_context *ctx, int slot, const double *h)
 {
-    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     const home__refine_state *st = &ctx->refine;
     double cost[2][REGIONS_X * REGIONS_Y], hn[9], sigma, c;
     int count[REGIONS_X * REGIONS_Y], e, i, r, votes = 0, wins = 0, fl, n4;
@@ -973,7 +974,6 @@ static int find_slot(const home__refine_state *st, uint32_t id)
 /* Failure rule with the refinement (documented in home.h at home_match). */
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
 {
-    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     home__refine_state *st = &ctx->refine;
     home_result trial;
     int slot, vouches, agrees, has_estimate;

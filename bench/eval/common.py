@@ -5,6 +5,7 @@ Conventions: H maps image A's pixel coordinates to image B's (x right, y down,
 top-left pixel centre at (0, 0)), which is both home-register's and OpenCV's.
 """
 import concurrent.futures
+import subprocess
 import zlib
 
 import cv2
@@ -100,3 +101,12 @@ def parallel_map(fn, items, jobs):
         return [fn(x) for x in items]
     with concurrent.futures.ThreadPoolExecutor(jobs) as ex:
         return list(ex.map(fn, items))
+
+
+def git_describe(where):
+    """The commit of the work tree `where` lies in (the HOME binary's build)."""
+    try:
+        return subprocess.run(["git", "-C", str(where), "describe", "--always", "--dirty"],
+                              capture_output=True, text=True).stdout.strip() or "?"
+    except OSError:
+        return "?"

@@ -36,16 +36,22 @@ OX, OY = (FULL_W - CROP_W) // 2, (FULL_H - CROP_H) // 2
 FULL_PLAN = {"p": P_LIST, "alpha": ALPHAS, "pairs": PAIRS_PER_IMAGE}
 
 
-def make_pair(full, name, p, idx, alpha=0.0):
-    """(A, B, H_true) for one pair of the protocol."""
-    key = f"{name}|p{p}|{idx}"
+def warp_full(full, key, p):
+    """The protocol's geometry: the full frame warped by moving its corners up to p px (seeded
+    by key), and the true homography between the central crops (not normalised)."""
     src = np.float32([[0, 0], [FULL_W - 1, 0], [0, FULL_H - 1], [FULL_W - 1, FULL_H - 1]])
     dst = src + rng_for(key).uniform(-p, p, (4, 2)).astype(np.float32)
     Hf = cv2.getPerspectiveTransform(src, dst)
     warped = cv2.warpPerspective(full, Hf, (FULL_W, FULL_H), flags=cv2.INTER_LINEAR,
                                  borderMode=cv2.BORDER_REFLECT)
     T = np.array([[1, 0, OX], [0, 1, OY], [0, 0, 1]], float)
-    Hc = np.linalg.inv(T) @ Hf @ T
+    return warped, np.linalg.inv(T) @ Hf @ T
+
+
+def make_pair(full, name, p, idx, alpha=0.0):
+    """(A, B, H_true) for one pair of the protocol."""
+    key = f"{name}|p{p}|{idx}"
+    warped, Hc = warp_full(full, key, p)
     noise = rng_for(key + "|noise")
     out = []
     for im in (full, warped):

@@ -14,7 +14,6 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -27,7 +26,7 @@ import catalogue                                     # noqa: E402
 import pairs_eval                                    # noqa: E402
 import report                                        # noqa: E402
 import video_eval                                    # noqa: E402
-from common import corner_error, parallel_map, photometric_rmse  # noqa: E402
+from common import corner_error, git_describe, parallel_map, photometric_rmse  # noqa: E402
 from data import Library                             # noqa: E402
 from methods import HomeCli, registry                # noqa: E402
 
@@ -76,15 +75,6 @@ def serialisable(records):
                             for k, v in res.items()} for m, res in rec["results"].items()}
         out.append(r)
     return out
-
-
-def git_describe(where):
-    """The commit of the work tree `where` lies in (the HOME binary's build)."""
-    try:
-        return subprocess.run(["git", "-C", str(where), "describe", "--always", "--dirty"],
-                              capture_output=True, text=True).stdout.strip() or "?"
-    except OSError:
-        return "?"
 
 
 def main():

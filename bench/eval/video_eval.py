@@ -70,6 +70,8 @@ def world_image(lib, scene):
 class Camera:
     """The pose at (fractional) frame time t, as the 3x3 M_t."""
 
+    path_frames = PATH_FRAMES   # the path's time scale (a subclass may slow it)
+
     def __init__(self, key, n_frames, world_shape):
         rng = rng_for(key)
         wh, ww = world_shape
@@ -87,7 +89,7 @@ class Camera:
         self.jitter = jitter
 
     def M(self, t):
-        u = t / PATH_FRAMES
+        u = t / self.path_frames
         ph = self.phase
         jitter = np.array([np.interp(t + 1, np.arange(len(self.jitter)), self.jitter[:, k])
                            for k in range(3)])
