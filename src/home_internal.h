@@ -65,6 +65,9 @@ typedef struct home__refine_state {
     uint32_t pyr_id, slot_id[2];
     int next_slot;
     home__refine_points tpl[2][HOME_REFINE_MAX_LEVELS];
+    home__refine_points regions[2];   /* the strongest points of every region of a grid at
+                                         region_level, for the identity test (x, y, t only) */
+    int region_level;
     const home__refine_kernels *rk;   /* SIMD backend, as cfg.simd */
     void *scratch;
 } home__refine_state;

@@ -53,8 +53,14 @@
                                   template points do not carry independent noise) */
 #define REGIONS_X 8          /* the identity test's grid of regions (identity_region_share) */
 #define REGIONS_Y 6
-#define REGION_POINTS 3      /* a region with fewer template points does not vote */
-#define STATIC_SHARE 0.5     /* the identity replaces a small motion that wins fewer regions */
+#define REGION_TOP 8         /* the identity test's points per region: the strongest blocks */
+#define REGION_POINTS 3      /* a region with fewer points does not vote */
+#define STATIC_SHARE 0.5     /* the identity replaces a motion that wins fewer regions */
+#define TWO_MOTIONS_SHARE 0.25 /* ... and a motion the identity contests this much is not ok */
+#define DECISIVE_RATIO 0.5   /* a region votes when its better cost is at most this share of the
+                                other's */
+#define DECISIVE_GREY 1.0    /* ... and they differ by more than this (grey levels) per point */
+#define MIN_VOTES 6          /* fewer voting regions: no decision (share 0) */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
                                  without HOME's confirmation, the tuning set's wrong refined
@@ -135,12 +141,21 @@ static int finest_for(const home_config *cfg)
  * pass but one 2x2 mean). */
 static int base_for(const home_config *cfg) { return finest_for(cfg) > 0 ? 1 : 0; }
 
+#define REGION_CAPACITY (REGIONS_X * REGIONS_Y * REGION_TOP)
+
+/* Points a match-time scratch buffer holds: the finest template's, or the region points. */
+static int match_capacity(const home_config *cfg)
+{
+    const int c = level_capacity(cfg, finest_for(cfg));
+    return c > REGION_CAPACITY ? c : REGION_CAPACITY;
+}
+
 /* Scratch: per-point floats at match time (two warps, residuals, weights), or at extraction
  * time a row of int16 for the blur, then the half-size image (base level 1) or, later, the
  * block cells. */
 static size_t scratch_bytes(const home_config *cfg)
 {
-    size_t match = 4 * (size_t)level_capacity(cfg, finest_for(cfg)) * sizeof(float), sel = 0;
+    size_t match = 4 * (size_t)match_capacity(cfg) * sizeof(float), sel = 0;
     int l;
     for (l = finest_for(cfg); l < levels_for(cfg); l++) {
         size_t s = blocks_at(cfg, l) * sizeof(uint16_t);
@@ -163,7 +178,8 @@ size_t home__refine_bytes(const home_config *cfg)
         if (l >= finest_for(cfg)) /* no template below the finest level */
             total += 2 * 5 * align64((size_t)(level_capacity(cfg, l) + LANES) * sizeof(int16_t));
     }
-    if (n) total += align64(scratch_bytes(cfg));
+    if (n) total += align64(scratch_bytes(cfg)) +
+                    2 * 3 * align64((size_t)(REGION_CAPACITY + LANES) * sizeof(int16_t));
     return total;
 }
 
@@ -175,6 +191,9 @@ void home__refine_init(home_context *ctx, unsigned char *block)
     st->levels = ctx->cfg.refine_levels ? levels_for(&ctx->cfg) : 0;
     st->finest_level = st->levels ? finest_for(&ctx->cfg) : 0;
     st->base_level = st->levels ? base_for(&ctx->cfg) : 0;
+    /* half size at most: a faint background's gradient is above the floor there, and the blur
+     * and the 2x2 mean have halved the noise */
+    st->region_level = st->finest_level < 1 && st->levels > 1 ? 1 : st->finest_level;
     st->rk = home__refine_kernels_for(ctx->cfg.simd);
     if (!st->rk) st->rk = &home__refine_kernels_scalar; /* every backend gives the same result */
     for (l = 0; l < st->levels; l++) {
@@ -193,6 +212,14 @@ void home__refine_init(home_context *ctx, unsigned char *block)
             p->gx = (int16_t *)(void *)block; block += bytes;
             p->gy = (int16_t *)(void *)block; block += bytes;
         }
+    }
+    for (s = 0; s < 2 && st->levels; s++) {
+        home__refine_points *p = &st->regions[s];
+        const size_t bytes = align64((size_t)(REGION_CAPACITY + LANES) * sizeof(int16_t));
+        p->capacity = REGION_CAPACITY;
+        p->x = (int16_t *)(void *)block; block += bytes;
+        p->y = (int16_t *)(void *)block; block += bytes;
+        p->t = (int16_t *)(void *)block; block += bytes;
     }
     st->scratch = st->levels ? (void *)block : NULL;
 }
@@ -301,6 +328,57 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
     for (; n % LANES; n++) out->x[n] = out->y[n] = out->t[n] = out->gx[n] = out->gy[n] = 0;
 }
 
+/* Region of a level pixel in the identity test's grid. */
+static int region_of(int x, int y, int w, int h)
+{
+    return (y * REGIONS_Y / h) * REGIONS_X + x * REGIONS_X / w;
+}
+
+/* The identity test's points from the block cells select_points left for this level: of every
+ * region, its REGION_TOP strongest blocks above the level's floor (ties: scan order). A moving
+ * object's texture fills the template's capacity, and the static background then has no say;
+ * per region it keeps its own. */
+static void select_region_points(const uint8_t *img, int w, int h, int level,
+                                 const uint16_t *cells, home__refine_points *out)
+{
+    const int b = block_side(level);
+    const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
+    const int log2b = b == 4 ? 2 : b == 2 ? 1 : 0;
+    const int floor_key = (score_floor(level) / 2 + 1) << 5;
+    int16_t key[REGION_CAPACITY];
+    int bx, by, i, j, r, n = 0;
+    for (i = 0; i < REGION_CAPACITY; i++) key[i] = 0;
+    for (by = 0; by < bh; by++) {
+        for (bx = 0; bx < bw; bx++) {
+            const int k = cells[by * bw + bx];
+            int x, y;
+            if (k < floor_key) continue;
+            x = bx * b + (k & (b - 1));
+            y = by * b + ((k & 15) >> log2b);
+            r = region_of(x, y, w, h) * REGION_TOP;
+            if (k <= key[r + REGION_TOP - 1]) continue;
+            /* insert, strongest first; an equal key keeps the earlier block ahead */
+            for (j = REGION_TOP - 1; j > 0 && key[r + j - 1] < k; j--) {
+                key[r + j] = key[r + j - 1];
+                out->x[r + j] = out->x[r + j - 1];
+                out->y[r + j] = out->y[r + j - 1];
+            }
+            key[r + j] = (int16_t)k;
+            out->x[r + j] = (int16_t)x;
+            out->y[r + j] = (int16_t)y;
+        }
+    }
+    for (i = 0; i < REGION_CAPACITY; i++) {
+        if (!key[i]) continue;
+        out->x[n] = out->x[i];
+        out->y[n] = out->y[i];
+        out->t[n] = (int16_t)img[(ptrdiff_t)out->y[n] * w + out->x[n]];
+        n++;
+    }
+    out->n = n;
+    for (; n % LANES; n++) out->x[n] = out->y[n] = out->t[n] = 0;
+}
+
 uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
 {
     home__refine_state *st = &ctx->refine;
@@ -326,8 +404,13 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     st->pyr_id = hash_bytes(st->pyr[l], (size_t)st->w[l] * (size_t)st->h[l]);
     slot = st->next_slot;
     st->next_slot ^= 1;
-    for (l = st->finest_level; l < st->levels; l++)
-        select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
+    /* the region points' level last: its block cells stay for them */
+    for (l = st->levels - 1; l >= st->finest_level; l--)
+        if (l != st->region_level)
+            select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
+    l = st->region_level;
+    select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
+    select_region_points(st->pyr[l], st->w[l], st->h[l], l, cells, &st->regions[slot]);
     st->slot_id[slot] = st->pyr_id;
     return st->pyr_id;
 }
@@ -789,7 +872,7 @@ static void solver_setup(home_context *ctx, int slot, solver *s)
 {
     const home__refine_state *st = &ctx->refine;
     float *scratch = (float *)st->scratch;
-    const int cap = level_capacity(&ctx->cfg, st->finest_level);
+    const int cap = match_capacity(&ctx->cfg);
     memset(s, 0, sizeof *s);
     s->st = st;
     s->tpl = st->tpl[slot];
@@ -808,21 +891,25 @@ static void solver_setup(home_context *ctx, int slot, solver *s)
 }
 
 /* Share of the frame's regions (a REGIONS_X x REGIONS_Y grid; those with at least REGION_POINTS
- * template points vote) whose points the identity explains better than h (pixels) does: the
- * robust photometric cost of each region under both, gain and bias fitted to each. Moving
- * objects are textured and draw the template points (and HOME's lines) to themselves; the
- * static background wins by area. */
-static double identity_region_share(home_context *ctx, int slot, const double *h)
+ * of the region points vote) whose points the identity explains better than h (pixels) does:
+ * the robust photometric cost of each region under both, each with the better of the two
+ * estimates' gain and bias. clear_share: the same over the regions one of them explains
+ * clearly better. Moving objects are textured and draw the template points (and HOME's lines)
+ * to themselves; the static background wins by area. */
+static double identity_region_share(home_context *ctx, int slot, const double *h,
+                                    double *clear_share)
 {
     const home__refine_state *st = &ctx->refine;
-    double cost[2][REGIONS_X * REGIONS_Y], hn[9], sigma, c;
-    int count[REGIONS_X * REGIONS_Y], e, i, r, votes = 0, wins = 0, fl, n4;
+    double cost[2][2][REGIONS_X * REGIONS_Y], gain[2], bias[2], hn[9], sigma, c, cost_h, cost_i;
+    int count[REGIONS_X * REGIONS_Y], e, i, k, r, votes = 0, wins = 0, clear_votes = 0, fl, n4;
+    int clear_wins = 0;
     const home__refine_points *tp;
     float m[9];
     solver s;
+    *clear_share = 0.0;
     solver_setup(ctx, slot, &s);
-    fl = s.finest;
-    tp = &s.tpl[fl];
+    fl = st->region_level;
+    tp = &st->regions[slot];
     if (tp->n < MIN_POINTS) return 0.0;
     n4 = (tp->n + LANES - 1) & ~(LANES - 1);
     to_normalised(&s, h, hn);
@@ -830,29 +917,47 @@ static double identity_region_share(home_context *ctx, int slot, const double *h
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
     level_matrix(&s, identity, fl, m);
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
-    /* one scale for both: the estimate's residuals (the identity's would let it excuse itself) */
+    /* one scale for both costs: the estimate's residuals (the identity's would let it excuse
+     * itself) */
     fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
     sigma = robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta, (int32_t *)(void *)s.wt);
     c = CAUCHY_K * sigma;
-    memset(cost, 0, sizeof cost);
-    memset(count, 0, sizeof count);
+    /* each estimate's own gain and bias: moving objects pull the identity's far off the
+     * background's, so every region is scored under both and keeps its better one */
     for (e = 0; e < 2; e++) {
-        const float *img = e ? s.img_b2 : s.img_b;
         s.alpha = 1.0;
         s.beta = 0.0;
-        for (i = 0; i < 2; i++) fit_photometric(&s, tp, img, e ? s.img_b : s.img_b2, sigma, s.res, s.wt);
-        for (i = 0; i < tp->n; i++) {
-            if (s.img_b[i] < 0.0f || s.img_b2[i] < 0.0f) continue;
-            r = (tp->y[i] * REGIONS_Y / st->h[fl]) * REGIONS_X + tp->x[i] * REGIONS_X / st->w[fl];
-            cost[e][r] += robust_cost(s.res[i], c);
-            count[r] += !e;
+        for (i = 0; i < 2; i++)
+            fit_photometric(&s, tp, e ? s.img_b2 : s.img_b, e ? s.img_b : s.img_b2, sigma, s.res, s.wt);
+        gain[e] = s.alpha;
+        bias[e] = s.beta;
+    }
+    memset(cost, 0, sizeof cost);
+    memset(count, 0, sizeof count);
+    for (i = 0; i < tp->n; i++) {
+        if (s.img_b[i] < 0.0f || s.img_b2[i] < 0.0f) continue;
+        r = region_of(tp->x[i], tp->y[i], st->w[fl], st->h[fl]);
+        count[r]++;
+        for (e = 0; e < 2; e++) {
+            const double v = e ? s.img_b2[i] : s.img_b[i];
+            for (k = 0; k < 2; k++) cost[e][k][r] += robust_cost(gain[k] * v + bias[k] - tp->t[i], c);
         }
     }
     for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
         if (count[r] < REGION_POINTS) continue;
+        cost_h = cost[0][0][r] < cost[0][1][r] ? cost[0][0][r] : cost[0][1][r];
+        cost_i = cost[1][0][r] < cost[1][1][r] ? cost[1][0][r] : cost[1][1][r];
         votes++;
-        wins += cost[1][r] < cost[0][r];
+        wins += cost_i < cost_h;
+        /* a clear vote: at most half the other's cost, and more than a grey level per point
+         * apart (near the identity, or on flat regions, the costs tie) */
+        if ((cost_i < cost_h ? cost_i : cost_h) > DECISIVE_RATIO * (cost_i < cost_h ? cost_h : cost_i) ||
+            fabs(cost_i - cost_h) <= DECISIVE_GREY * DECISIVE_GREY * count[r])
+            continue;
+        clear_votes++;
+        clear_wins += cost_i < cost_h;
     }
+    *clear_share = clear_votes >= MIN_VOTES ? (double)clear_wins / clear_votes : 0.0;
     return votes >= REGIONS_X * REGIONS_Y / 4 ? (double)wins / votes : 0.0;
 }
 
@@ -977,7 +1082,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     home__refine_state *st = &ctx->refine;
     home_result trial;
     int slot, vouches, agrees, has_estimate;
-    double t0 = home__now(ctx), radius, d;
+    double t0 = home__now(ctx), radius, d, share, clear_share;
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
     if (!st->levels) return;
@@ -1046,11 +1151,16 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     }
     /* a small motion the static background does not share is the moving objects' */
     if (trial.ok && trial.model != HOME_MODEL_IDENTITY &&
-        corner_distance(ctx, trial.H, identity) <= ctx->cfg.refine_trust_px * ctx->hough_scale &&
-        identity_region_share(ctx, slot, trial.H) >= STATIC_SHARE) {
-        memcpy(trial.H, identity, sizeof trial.H);
-        trial.model = HOME_MODEL_IDENTITY;
-        trial.refine_status = HOME_REFINE_STATIC;
+        ((share = identity_region_share(ctx, slot, trial.H, &clear_share)) >= STATIC_SHARE ||
+         clear_share >= TWO_MOTIONS_SHARE)) {
+        if (share >= STATIC_SHARE || clear_share >= STATIC_SHARE) {
+            memcpy(trial.H, identity, sizeof trial.H);
+            trial.model = HOME_MODEL_IDENTITY;
+            trial.refine_status = HOME_REFINE_STATIC;
+        } else {
+            trial.ok = 0;
+            trial.failure = HOME_FAIL_INCONSISTENT;
+        }
     }
     *result = trial;
     result->ms[HOME_STAGE_REFINE] += home__now(ctx) - t0;
