@@ -199,7 +199,9 @@ enum home_failure {
     HOME_FAIL_UNCERTAIN,      /* no model up to max_model is determined by the inliers, or the
                                  predicted error (sigma_px) is above max_sigma_px */
     HOME_FAIL_INCONSISTENT    /* the refinement converged far from HOME's estimate (beyond
-                                 its uncertainty) and cannot vouch for its own */
+                                 its uncertainty) and cannot vouch for its own, or the frame
+                                 holds two motions: regions the identity clearly explains
+                                 better (a static background) beside the estimate's */
 };
 
 /* Name of a failure ("none", "few_matches", ...; "unknown" when out of range). */
@@ -224,8 +226,9 @@ enum home_refine_status {
     HOME_REFINE_LOW_CORRELATION,  /* HOME failed and the refinement cannot vouch (rule below) */
     HOME_REFINE_LESS_PRECISE,     /* the refined H agrees with HOME's but predicts a larger
                                      error (sigma_px): HOME's H stays */
-    HOME_REFINE_STATIC            /* a small motion most of the frame's regions do not share
-                                     (moving objects): H is the identity */
+    HOME_REFINE_STATIC            /* a motion most of the frame's regions do not share
+                                     (moving objects), or one within 2 sigma_px of the
+                                     identity: H is the identity */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */
@@ -275,9 +278,13 @@ typedef struct home_result {
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the
  * identity is tried; it vouches like an overruling refinement and must stay within
- * refine_trust_px of the identity. An ok small motion (within refine_trust_px of the identity)
- * that most of the frame's regions explain worse than the identity does is the moving
- * objects': H becomes the identity (HOME_REFINE_STATIC). */
+ * refine_trust_px of the identity.
+ *
+ * Static camera: an ok motion within 2 sigma_px of the identity, or one that most regions of an
+ * 8x6 grid explain worse than the identity does (each region votes with its own strongest
+ * points, so textured moving objects cannot outvote a plainer background), becomes the
+ * identity (HOME_REFINE_STATIC). One the identity clearly explains better in a tenth of the
+ * clearly decided regions is two motions, not ok (HOME_FAIL_INCONSISTENT). */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 

@@ -56,10 +56,11 @@
 #define REGION_TOP 8         /* the identity test's points per region: the strongest blocks */
 #define REGION_POINTS 3      /* a region with fewer points does not vote */
 #define STATIC_SHARE 0.5     /* the identity replaces a motion that wins fewer regions */
-#define TWO_MOTIONS_SHARE 0.25 /* ... and a motion the identity contests this much is not ok */
+#define TWO_MOTIONS_SHARE 0.1 /* ... and a motion the identity contests this much is not ok */
 #define DECISIVE_RATIO 0.5   /* a region votes when its better cost is at most this share of the
                                 other's */
 #define DECISIVE_GREY 1.0    /* ... and they differ by more than this (grey levels) per point */
+#define IDENTITY_SIGMAS 2.0  /* a motion within this many predicted errors of the identity is it */
 #define MIN_VOTES 6          /* fewer voting regions: no decision (share 0) */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
@@ -1149,7 +1150,15 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         trial.ok = 0;
         trial.failure = HOME_FAIL_INCONSISTENT;
     }
-    /* a small motion the static background does not share is the moving objects' */
+    /* a motion its own predicted error cannot tell from the identity is no evidence of one */
+    if (trial.ok && trial.model != HOME_MODEL_IDENTITY &&
+        isfinite(trial.sigma_px) &&
+        corner_distance(ctx, trial.H, identity) <= IDENTITY_SIGMAS * trial.sigma_px) {
+        memcpy(trial.H, identity, sizeof trial.H);
+        trial.model = HOME_MODEL_IDENTITY;
+        trial.refine_status = HOME_REFINE_STATIC;
+    }
+    /* a motion the static background does not share is the moving objects' */
     if (trial.ok && trial.model != HOME_MODEL_IDENTITY &&
         ((share = identity_region_share(ctx, slot, trial.H, &clear_share)) >= STATIC_SHARE ||
          clear_share >= TWO_MOTIONS_SHARE)) {
