@@ -51,7 +51,8 @@ $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_inte
 # mode (no contraction, no reassociation), so bit-identical output.
 # The line fit (src/homography.c) works on four matches per step in separate lanes, element-wise
 # too; its sqrt vectorises only without errno (-fno-math-errno: same IEEE square roots).
-$(BUILD)/obj/src/hough.o $(BUILD)/obj/src/refine.o $(BUILD)/obj/src/describe.o $(BUILD)/obj/src/pipeline.o: CFLAGS_LIB += -ftree-vectorize
+$(BUILD)/obj/src/hough.o $(patsubst src/%.c,$(BUILD)/obj/src/%.o,$(wildcard src/refine*.c)) \
+$(BUILD)/obj/src/describe.o $(BUILD)/obj/src/pipeline.o: CFLAGS_LIB += -ftree-vectorize
 # port/line_fit_avx2.c is the same fit compiled with AVX2 (four lanes, one 256-bit operation).
 $(BUILD)/obj/src/homography.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno
 $(BUILD)/obj/port/line_fit_avx2.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno $(AVX2_FLAGS)

@@ -51,7 +51,7 @@ fuzz-build:
 # mutator. Validation and decisions (arena.c, match.c, homography.c, stabilise.c) keep it;
 # pipeline.c (the per-row detection callback) and lm.c (the solver's loops) were a further 10%.
 FUZZ_NO_TRACE_CMP := $(wildcard port/*.c) src/hough.c src/smooth.c src/gradient.c src/extrema.c \
-	src/describe.c src/refine.c src/warp.c src/pipeline.c src/lm.c
+	src/describe.c $(wildcard src/refine*.c) src/warp.c src/pipeline.c src/lm.c
 ifeq ($(BUILD),$(FUZZ_BUILD))
 $(patsubst %.c,$(BUILD)/obj/%.o,$(FUZZ_NO_TRACE_CMP)): CFLAGS_LIB += -fno-sanitize-coverage=trace-cmp
 endif

@@ -20,7 +20,7 @@ $(REFINE_PAIR): $(BUILD)/obj/bench/refine/refine-pair.o $(SUPPORT_OBJ) $(LIB)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
 # port/refine_kernels.h is not in the generic object rules' prerequisites
-$(BUILD)/obj/src/refine.o $(BUILD)/obj/src/arena.o $(BUILD)/obj/src/pipeline.o $(BUILD)/obj/tests/test_refine.o: port/refine_kernels.h
+$(patsubst src/%.c,$(BUILD)/obj/src/%.o,$(wildcard src/refine*.c)) $(BUILD)/obj/src/arena.o $(BUILD)/obj/src/pipeline.o $(BUILD)/obj/tests/test_refine.o: port/refine_kernels.h
 $(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/refine_*.c)): port/refine_kernels.h
 $(BUILD)/obj/port/refine_avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 
@@ -35,3 +35,4 @@ $(REFINE_BENCH): $(BUILD)/obj/bench/refine/bench_refine.o $(SUPPORT_OBJ) $(LIB)
 bench-refine: $(REFINE_BENCH)
 	$(RUNNER) $(REFINE_BENCH) --frames 40
 	$(RUNNER) $(REFINE_BENCH) --frames 40 --kind weak
+$(patsubst src/%.c,$(BUILD)/obj/src/%.o,$(wildcard src/refine*.c)): src/refine_internal.h

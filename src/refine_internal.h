@@ -1,0 +1,80 @@
+/* The photometric refinement's parts (src/refine*.c): the per-frame snapshot
+ * (refine_snapshot.c), the Gauss-Newton solver (refine_solve.c), the static-camera test
+ * (refine_static.c) and the rule that weighs it all against HOME's estimate (refine.c). */
+#ifndef HOME_REFINE_INTERNAL_H
+#define HOME_REFINE_INTERNAL_H
+
+#include "home_internal.h"
+
+#define LANES HOME__REFINE_LANES
+#define N_ACC HOME__REFINE_ACC
+#define CAUCHY_K 2.385     /* 95 % efficiency at Gaussian noise */
+#define SIGMA_FLOOR 0.5     /* grey levels: the residual scale never collapses below this */
+#define MIN_POINTS 64       /* fewer usable template points at a level: textureless, decline */
+#define FINEST_MIN_POINTS 512 /* the level the estimate ends at needs this many points, else the
+                                 next coarser one is the finest (faint texture: less noise there) */
+#define REGIONS_X 8          /* the identity test's grid of regions (identity_region_share) */
+#define REGIONS_Y 6
+#define REGION_TOP 8         /* the identity test's points per region: the strongest blocks */
+#define REGION_CAPACITY (REGIONS_X * REGIONS_Y * REGION_TOP)
+
+/* One refinement: the template, the estimate and the solver's state. */
+typedef struct home__refine_solver {
+    const home__refine_state *st;
+    const home__refine_points *tpl;     /* template (frame A) points, one per level */
+    double f, cx, cy;                   /* normalisation */
+    double hn[9];                       /* A -> B in normalised coordinates */
+    double alpha, beta;                 /* photometric model alpha * B + beta ~ A */
+    double sigma;                       /* residual scale of the last iteration */
+    double jtj[64];                     /* last weighted normal matrix (normalised units) */
+    float acc[N_ACC * LANES];           /* per-lane sums of the normal equations */
+    int hessian_level;                  /* level whose J^T W J acc holds (-1: none yet) */
+    double resid_var;                   /* weighted residual variance of the last iteration
+                                           (set once the finest level converged) */
+    double split_px;                    /* split-half disagreement of the last finest step */
+    int finest;                         /* level the estimate ends at */
+    int k;                              /* parameters of the model fitted (8: a homography) */
+    double basis[8][8];                 /* the update's subspace dp = B q when k < 8 */
+    float *img_b, *img_b2, *res, *wt;   /* per-point scratch */
+} home__refine_solver;
+
+extern const double home__refine_identity[9];
+
+/* Region of a level pixel in the identity test's grid. */
+static inline int region_of(int x, int y, int w, int h)
+{
+    return (y * REGIONS_Y / h) * REGIONS_X + x * REGIONS_X / w;
+}
+
+/* The acceptance test's error per point: Geman-McClure, bounded like the Cauchy weights'
+ * influence and made of IEEE operations only (no libm), so every platform decides alike. */
+static inline double robust_cost(double r, double c)
+{
+    double q = r / c;
+    return 0.5 * r * r / (1.0 + q * q);
+}
+
+/* refine_snapshot.c: points a match-time scratch buffer holds */
+int home__refine_match_capacity(const home_config *cfg);
+
+/* refine_solve.c */
+void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver *s);
+void home__refine_to_normalised(const home__refine_solver *s, const double *h, double *hn);
+void home__refine_level_matrix(const home__refine_solver *s, const double *hn, int level,
+                               float *m);
+double home__refine_robust_sigma(const float *img_b, const int16_t *t, int n, double alpha,
+                                 double beta, int32_t *bins);
+int home__refine_fit_photometric(home__refine_solver *s, const home__refine_points *tp,
+                                 const float *img_b, const float *mask, double sigma, float *res,
+                                 float *wt);
+double home__refine_max_corner_distance(double cx, double cy, const double *h1,
+                                        const double *h2);
+/* Refine h0 (A -> B pixels) with the template of slot `slot` against the stored pyramid:
+ * the refined H and the refine fields of result. */
+void home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result);
+
+/* refine_static.c */
+double home__refine_identity_share(home_context *ctx, int slot, const double *h,
+                                   double *clear_share);
+
+#endif

@@ -1,0 +1,572 @@
+/* The refinement's Gauss-Newton solver: inverse-compositional Lucas-Kanade of the
+ * homography's 8 parameters (or a smaller model's) coarse to fine on the snapshot's pyramid,
+ * with a fitted gain and bias and Cauchy weights, and the predicted error of its estimate. */
+#include "refine_internal.h"
+#include <math.h>
+#include <string.h>
+
+#define HIST_BINS 512       /* |residual| histogram, 1/8 grey level per bin */
+#define STEP_EPS_PX 0.02    /* convergence: largest corner update, full-resolution px */
+#define STEP_NOISE_SHARE 0.25 /* ... or at the finest level, this share of the worst corner's
+                                 predicted standard deviation */
+#define NOISE_CHECK_PX 0.5  /* (that prediction is made only for steps below this) */
+#define MAX_CORNER_STD_PX 0.5 /* worst corner's standard deviation (Fisher, or split-half) above
+                                 this, or above max_sigma_px: ill conditioned */
+#define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
+                                  (calibrated on the evaluation's tuning set: neighbouring
+                                  template points do not carry independent noise) */
+
+const double home__refine_identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+static void mat3_mul(const double *a, const double *b, double *out)
+{
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            out[i * 3 + j] = a[i * 3 + 0] * b[0 * 3 + j] + a[i * 3 + 1] * b[1 * 3 + j] +
+                             a[i * 3 + 2] * b[2 * 3 + j];
+}
+
+static int mat3_inv(const double *m, double *out)
+{
+    double d = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+               m[2] * (m[3] * m[7] - m[4] * m[6]);
+    if (!(fabs(d) > 1e-300) || !isfinite(d)) return 0;
+    out[0] = (m[4] * m[8] - m[5] * m[7]) / d;
+    out[1] = (m[2] * m[7] - m[1] * m[8]) / d;
+    out[2] = (m[1] * m[5] - m[2] * m[4]) / d;
+    out[3] = (m[5] * m[6] - m[3] * m[8]) / d;
+    out[4] = (m[0] * m[8] - m[2] * m[6]) / d;
+    out[5] = (m[2] * m[3] - m[0] * m[5]) / d;
+    out[6] = (m[3] * m[7] - m[4] * m[6]) / d;
+    out[7] = (m[1] * m[6] - m[0] * m[7]) / d;
+    out[8] = (m[0] * m[4] - m[1] * m[3]) / d;
+    return 1;
+}
+
+static void normalise9(double *h)
+{
+    int k;
+    double s = h[8];
+    for (k = 0; k < 9; k++) h[k] /= s;
+}
+
+/* pixel H -> normalised N H N^-1, and back */
+void home__refine_to_normalised(const home__refine_solver *s, const double *h, double *hn)
+{
+    const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
+    const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
+    double t[9] = {0}; /* all written by mat3_mul; zeroed for gcc's -fanalyzer (make lint) */
+    mat3_mul(n, h, t);
+    mat3_mul(t, ni, hn);
+    normalise9(hn);
+}
+
+static void to_pixels(const home__refine_solver *s, const double *hn, double *h)
+{
+    const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
+    const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
+    double t[9] = {0}; /* all written by mat3_mul; zeroed for gcc's -fanalyzer (make lint) */
+    mat3_mul(ni, hn, t);
+    mat3_mul(t, n, h);
+    normalise9(h);
+}
+
+/* Matrix taking template level-l pixels to B's level-l pixels under hn. */
+void home__refine_level_matrix(const home__refine_solver *s, const double *hn, int level, float *m)
+{
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const double q[9] = {sc / s->f, 0, (o - s->cx) / s->f, 0, sc / s->f, (o - s->cy) / s->f, 0,
+                         0,         1};
+    const double p[9] = {s->f / sc, 0, (s->cx - o) / sc, 0, s->f / sc, (s->cy - o) / sc, 0, 0, 1};
+    double t[9], r[9];
+    int k;
+    mat3_mul(hn, q, t);
+    mat3_mul(p, t, r);
+    for (k = 0; k < 9; k++) m[k] = (float)r[k];
+}
+
+/* Robust scale: 1.4826 * median |r| over the valid points, from a histogram. */
+double home__refine_robust_sigma(const float *img_b, const int16_t *t, int n, double alpha,
+                                 double beta, int32_t *bins)
+{
+    const float a = (float)alpha, b = (float)beta;
+    int hist[HIST_BINS + 2], i, count, half, acc = 0;
+    memset(hist, 0, sizeof hist);
+    /* bins first (element-wise: vectorised), then the histogram; invalid points in a spare bin */
+    for (i = 0; i < n; i++) {
+        const float r = fabsf(a * img_b[i] + b - (float)t[i]) * 8.0f;
+        const int bin = r < (float)HIST_BINS ? (int)r : HIST_BINS;
+        bins[i] = img_b[i] >= 0.0f ? bin : HIST_BINS + 1;
+    }
+    for (i = 0; i < n; i++) hist[bins[i]]++;
+    count = n - hist[HIST_BINS + 1];
+    if (!count) return SIGMA_FLOOR;
+    half = (count + 1) / 2;
+    for (i = 0; i <= HIST_BINS; i++) {
+        acc += hist[i];
+        if (acc >= half) break;
+    }
+    {
+        double med = (i + 0.5) / 8.0, sigma = 1.4826 * med;
+        return sigma > SIGMA_FLOOR ? sigma : SIGMA_FLOOR;
+    }
+}
+
+/* Weighted least-squares gain and bias of alpha * B + beta ~ A with Cauchy weights
+ * 1 / (1 + (r / c)^2), c = 2.385 sigma: the influence of a residual fades as 1 / |r| far out, so
+ * occluders and moving objects barely pull, yet no point is ever cut off outright. Scale
+ * sigma from the residuals of the current (alpha, beta); writes weights and new residuals.
+ * mask (optional): only points valid there too. Returns the number of valid points. */
+int home__refine_fit_photometric(home__refine_solver *s, const home__refine_points *tp,
+                                 const float *img_b, const float *mask, double sigma, float *res,
+                                 float *wt)
+{
+    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    float part[5 * LANES];
+    double sum[5], den;
+    int k, n;
+    n = s->st->rk->cauchy_sums(img_b, mask ? mask : img_b, tp->t, n4, tp->n, (float)s->alpha,
+                               (float)s->beta, (float)(1.0 / (CAUCHY_K * sigma)), wt, part);
+    for (k = 0; k < 5; k++)
+        sum[k] = ((double)part[k * LANES] + part[k * LANES + 1]) +
+                 ((double)part[k * LANES + 2] + part[k * LANES + 3]);
+    /* sum: w, w b, w a, w b b, w b a */
+    if (n && sum[0] > 0) {
+        den = sum[0] * sum[3] - sum[1] * sum[1];
+        if (den > 1e-6 * sum[0] * sum[0]) {
+            s->alpha = (sum[0] * sum[4] - sum[1] * sum[2]) / den;
+            s->beta = (sum[2] - s->alpha * sum[1]) / sum[0];
+        } else {
+            s->alpha = 1.0;
+            s->beta = (sum[2] - sum[1]) / sum[0];
+        }
+    }
+    s->st->rk->residuals(img_b, tp->t, wt, n4, (float)s->alpha, (float)s->beta, res);
+    return n;
+}
+
+/* Largest displacement of the image corners (full-resolution px) by the linearised update dp. */
+static double corner_step_px(const home__refine_solver *s, const double *dp)
+{
+    const double hu = s->cx / s->f, hv = s->cy / s->f;
+    double worst = 0.0;
+    int k;
+    for (k = 0; k < 4; k++) {
+        double u = (k & 1) ? hu : -hu, v = (k & 2) ? hv : -hv;
+        double du = dp[0] * u + dp[1] * v + dp[2] - (dp[6] * u + dp[7] * v) * u;
+        double dv = dp[3] * u + dp[4] * v + dp[5] - (dp[6] * u + dp[7] * v) * v;
+        double d = sqrt(du * du + dv * dv) * s->f;
+        if (d > worst) worst = d;
+    }
+    return worst;
+}
+
+/* Normal equations (J^T W J, J^T W r) in normalised units from the lanes in lane_mask. */
+static void normal_equations(const float *acc, unsigned lane_mask, double k, double *a, double *g)
+{
+    int p, q, j, l;
+    for (p = 0, j = 0; p < 8; p++) {
+        double v;
+        for (q = p; q < 8; q++, j++) {
+            for (l = 0, v = 0.0; l < LANES; l++)
+                if (lane_mask >> l & 1) v += (double)acc[j * LANES + l];
+            a[p * 8 + q] = a[q * 8 + p] = v * k * k;
+        }
+        for (l = 0, v = 0.0; l < LANES; l++)
+            if (lane_mask >> l & 1) v += (double)acc[(36 + p) * LANES + l];
+        g[p] = v * k;
+    }
+}
+
+/* x = B (B^T a B)^-1 B^T b: the solve in the model's parameters (a and b are overwritten; with
+ * all 8, a plain solve). 0 when not positive definite. */
+static int model_solve(const home__refine_solver *s, double *a, double *b)
+{
+    double aq[64], bq[8];
+    int i, j;
+    if (s->k == 8) return home__solve_spd8(a, b);
+    home__project_normal(s->basis, s->k, a, b, aq, bq);
+    if (!home__solve_spd(aq, bq, s->k)) return 0;
+    for (j = 0; j < 8; j++) {
+        double v = 0.0;
+        for (i = 0; i < s->k; i++) v += bq[i] * s->basis[i][j];
+        b[j] = v;
+    }
+    return 1;
+}
+
+/* One IRLS Gauss-Newton step at a level. Returns 0 when too few points stay usable or the
+ * system is singular; *step_px gets the corner motion of the update. */
+static int iterate(home__refine_solver *s, int level, double *step_px)
+{
+    const home__refine_state *st = s->st;
+    const home__refine_points *tp = &s->tpl[level];
+    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const double k = s->f / (2.0 * sc);  /* template gradient: 2x central difference per level px */
+    float m[9], aff[3], *acc = s->acc;
+    double a[64], g[8], dp[9], hd[9], hdi[9], t[9];
+    int i, p, valid;
+
+    home__refine_level_matrix(s, s->hn, level, m);
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
+                      st->h[level], s->img_b);
+    s->sigma = home__refine_robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta,
+                                         (int32_t *)(void *)s->wt);
+    valid = home__refine_fit_photometric(s, tp, s->img_b, NULL, s->sigma, s->res, s->wt);
+    if (valid < MIN_POINTS) return 0;
+    aff[0] = (float)(sc / s->f);
+    aff[1] = (float)((o - s->cx) / s->f);
+    aff[2] = (float)((o - s->cy) / s->f);
+    /* J^T W J at a level's first iteration, then reused while the steps keep halving (a fresh
+     * one otherwise, see refine()): in the inverse-compositional form it changes only through
+     * the weights, and an approximate matrix changes the path to the solution, not the solution
+     * (J^T W r = 0). J^T W J is 36 of the 44 sums per point. */
+    st->rk->accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff,
+                       s->hessian_level != level, acc);
+    s->hessian_level = level;
+    normal_equations(acc, 0xf, k, a, g);
+    memcpy(s->jtj, a, sizeof a);
+    if (level == s->finest) {
+        /* split-half check: the steps of the even and the odd lanes (interleaved halves of the
+         * points) from the same estimate agree when the points carry signal and scatter when
+         * they carry template noise, which the Fisher covariance cannot see */
+        double ae[64], ge[8], ao[64], go[8];
+        normal_equations(acc, 0x5, k, ae, ge);
+        normal_equations(acc, 0xa, k, ao, go);
+        if (model_solve(s, ae, ge) && model_solve(s, ao, go)) {
+            for (p = 0; p < 8; p++) ge[p] -= go[p];
+            s->split_px = 0.5 * corner_step_px(s, ge);
+        } else {
+            s->split_px = INFINITY;
+        }
+    }
+    if (!model_solve(s, a, g)) return 0;
+    for (p = 0; p < 8; p++) dp[p] = g[p];
+    *step_px = corner_step_px(s, dp);
+    hd[0] = 1 + dp[0]; hd[1] = dp[1]; hd[2] = dp[2];
+    hd[3] = dp[3]; hd[4] = 1 + dp[4]; hd[5] = dp[5];
+    hd[6] = dp[6]; hd[7] = dp[7]; hd[8] = 1;
+    if (!mat3_inv(hd, hdi)) return 0;
+    mat3_mul(s->hn, hdi, t);
+    normalise9(t);
+    for (i = 0; i < 9; i++)
+        if (!isfinite(t[i])) return 0;
+    memcpy(s->hn, t, sizeof t);
+    return 1;
+}
+
+/* Weighted residual variance of the last iteration (its weights and residuals are still in the
+ * scratch), for the Fisher covariance below. */
+static double residual_variance(const home__refine_solver *s)
+{
+    const home__refine_points *tp = &s->tpl[s->finest];
+    double sum_w = 0, sum_wr2 = 0;
+    int i;
+    for (i = 0; i < tp->n; i++) {
+        sum_w += s->wt[i];
+        sum_wr2 += (double)s->wt[i] * s->res[i] * s->res[i];
+    }
+    return sum_w > 8 ? sum_wr2 / (sum_w - 8) : sum_wr2;
+}
+
+/* Predicted standard deviation of the worst corner, px: sqrt(J_c (sigma^2 A^-1) J_c^T). */
+static double corner_std_px(const home__refine_solver *s)
+{
+    const double hu = s->cx / s->f, hv = s->cy / s->f;
+    double worst = 0.0, l[64];
+    int k, axis, i, j;
+    /* one factor of the (model's) normal matrix for the eight corner coordinates */
+    if (s->k == 8) {
+        memcpy(l, s->jtj, sizeof l);
+    } else {
+        const double no_gradient[8] = {0};
+        double unused[8];
+        home__project_normal(s->basis, s->k, s->jtj, no_gradient, l, unused);
+    }
+    if (!home__cholesky8(l)) return INFINITY;
+    for (k = 0; k < 4; k++) {
+        double u = (k & 1) ? hu : -hu, v = (k & 2) ? hv : -hv, var = 0.0;
+        for (axis = 0; axis < 2; axis++) {
+            double jc[8], z[8], q = 0.0;
+            memset(jc, 0, sizeof jc);
+            if (axis == 0) { jc[0] = u; jc[1] = v; jc[2] = 1; jc[6] = -u * u; jc[7] = -u * v; }
+            else { jc[3] = u; jc[4] = v; jc[5] = 1; jc[6] = -u * v; jc[7] = -v * v; }
+            if (s->k == 8) {
+                memcpy(z, jc, sizeof z);
+            } else { /* B^T jc, zero beyond k */
+                for (i = 0; i < 8; i++) {
+                    z[i] = 0.0;
+                    for (j = 0; j < 8 && i < s->k; j++) z[i] += s->basis[i][j] * jc[j];
+                }
+                memcpy(jc, z, sizeof jc);
+            }
+            home__cholesky_solve8(l, z);
+            for (i = 0; i < 8; i++) q += jc[i] * z[i];
+            var += q;
+        }
+        var *= s->resid_var * s->f * s->f;
+        if (sqrt(var) > worst) worst = sqrt(var);
+    }
+    return worst;
+}
+
+/* Robust photometric error of the finest-level B samples img_b over the points other_b (the
+ * samples under the other estimate) keeps too: mean robust cost at the fixed scale sigma,
+ * after re-fitting gain and bias. Also the weighted correlation of A and B there. */
+static double photometric_error(home__refine_solver *s, const float *img_b, const float *other_b,
+                                double sigma, double *zncc)
+{
+    const home__refine_points *tp = &s->tpl[s->finest];
+    const double c = CAUCHY_K * sigma;
+    double cost = 0, sw = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, va, vb;
+    int i, it, n = 0;
+    s->alpha = 1.0;
+    s->beta = 0.0;
+    for (it = 0; it < 2; it++)
+        home__refine_fit_photometric(s, tp, img_b, other_b, sigma, s->res, s->wt);
+    for (i = 0; i < tp->n; i++) {
+        double w = s->wt[i], a = tp->t[i], b = img_b[i];
+        if (img_b[i] < 0.0f || other_b[i] < 0.0f) continue;
+        cost += robust_cost(s->res[i], c);
+        n++;
+        sw += w; sa += w * a; sb += w * b; saa += w * a * a; sbb += w * b * b; sab += w * a * b;
+    }
+    *zncc = 0.0;
+    if (sw > 0) {
+        va = saa - sa * sa / sw;
+        vb = sbb - sb * sb / sw;
+        if (va > 0 && vb > 0) *zncc = (sab - sa * sb / sw) / sqrt(va * vb);
+    }
+    return n ? cost / n : INFINITY;
+}
+
+/* Share of the points (valid under both estimates) whose residual under the estimate of img_b
+ * (s->res, left by photometric_error) is within 3 robust sigmas of its own: a refinement that
+ * aligned part of the scene (two edges of three, say) leaves the rest far off, and the robust
+ * weights that let it ignore them also hide them from the weighted correlation. */
+static double inlier_share(home__refine_solver *s, const float *img_b, const float *other_b)
+{
+    const home__refine_points *tp = &s->tpl[s->finest];
+    double sigma, limit;
+    int i, n = 0, in = 0;
+    /* the scale from the residuals (home__refine_robust_sigma's histogram bins go to the weights'
+     * scratch) */
+    sigma =
+        home__refine_robust_sigma(img_b, tp->t, tp->n, s->alpha, s->beta, (int32_t *)(void *)s->wt);
+    limit = 3.0 * sigma;
+    for (i = 0; i < tp->n; i++) {
+        if (img_b[i] < 0.0f || other_b[i] < 0.0f) continue;
+        n++;
+        in += fabs(s->res[i]) <= limit;
+    }
+    return n ? (double)in / n : 0.0;
+}
+
+double home__refine_max_corner_distance(double cx, double cy, const double *h1, const double *h2)
+{
+    const double xs[2] = {0.0, 2.0 * cx}, ys[2] = {0.0, 2.0 * cy};
+    double worst = 0.0;
+    int k;
+    for (k = 0; k < 4; k++) {
+        double x = xs[k & 1], y = ys[k >> 1];
+        double w1 = h1[6] * x + h1[7] * y + h1[8], w2 = h2[6] * x + h2[7] * y + h2[8];
+        double dx = (h1[0] * x + h1[1] * y + h1[2]) / w1 - (h2[0] * x + h2[1] * y + h2[2]) / w2;
+        double dy = (h1[3] * x + h1[4] * y + h1[5]) / w1 - (h2[3] * x + h2[4] * y + h2[5]) / w2;
+        double d = sqrt(dx * dx + dy * dy);
+        if (!(d <= worst)) worst = d; /* NaN counts as infinitely far */
+    }
+    return worst;
+}
+
+/* dp of the inverse-compositional update that takes hn to hn2 (both normalised, h8 = 1):
+ * hn2 = hn (I + D(dp))^-1, so I + D = hn2^-1 hn scaled to a unit corner. */
+static int update_between(const double *hn, const double *hn2, double *dp)
+{
+    double inv[9], m[9];
+    int k;
+    if (!mat3_inv(hn2, inv)) return 0;
+    mat3_mul(inv, hn, m);
+    if (!(fabs(m[8]) > 1e-12)) return 0;
+    normalise9(m);
+    for (k = 0; k < 8; k++) dp[k] = m[k] - (k == 0 || k == 4 ? 1.0 : 0.0);
+    return 1;
+}
+
+/* Model selection over the refinement's Fisher information (src/model.c): J^T W J over the
+ * weighted residual variance is the information of the update dp at the estimate; the chain
+ * rule through dp(h) (central differences) gives that of h's entries. h1 (pixels) becomes the
+ * chosen model's estimate; sets result->model and sigma_px. */
+static int choose_model(home__refine_solver *s, int max_model, double *h1, home_result *result)
+{
+    home__model_problem mp;
+    home__model_choice choice;
+    double jac[8][8], t[8][8], hn[9];
+    int i, j, a, b;
+    mp.space = HOME__SPACE_H;
+    for (j = 0; j < 8; j++) {
+        const double eps = 1e-7;
+        double hp[9], hm[9], dpp[8], dpm[8];
+        memcpy(hp, s->hn, sizeof hp);
+        memcpy(hm, s->hn, sizeof hm);
+        hp[j] += eps;
+        hm[j] -= eps;
+        if (!update_between(s->hn, hp, dpp) || !update_between(s->hn, hm, dpm)) return 0;
+        for (i = 0; i < 8; i++) jac[i][j] = (dpp[i] - dpm[i]) / (2 * eps);
+    }
+    for (a = 0; a < 8; a++) /* t = J^T W J  d dp / d h, then d dp / d h^T t */
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (b = 0; b < 8; b++) v += s->jtj[a * 8 + b] * jac[b][j];
+            t[a][j] = v;
+        }
+    for (i = 0; i < 8; i++)
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (a = 0; a < 8; a++) v += jac[a][i] * t[a][j];
+            mp.info[i * 8 + j] = v / (s->resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE);
+        }
+    memcpy(mp.p, s->hn, sizeof mp.p);
+    mp.penalty = log((double)s->tpl[s->finest].n);
+    mp.max_model = max_model;
+    mp.max_params = 8;
+    mp.scale = s->f;
+    mp.cx = s->cx;
+    mp.cy = s->cy;
+    if (!home__select_model(&mp, &choice)) return 0;
+    memcpy(hn, choice.p, 8 * sizeof *hn);
+    hn[8] = 1.0;
+    to_pixels(s, hn, h1);
+    result->model = choice.model;
+    result->sigma_px = choice.sigma_px;
+    return 1;
+}
+
+/* A solver on the template of slot `slot`, its scratch, the normalisation and the level the
+ * estimate ends at. */
+void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver *s)
+{
+    const home__refine_state *st = &ctx->refine;
+    float *scratch = (float *)st->scratch;
+    const int cap = home__refine_match_capacity(&ctx->cfg);
+    memset(s, 0, sizeof *s);
+    s->st = st;
+    s->tpl = st->tpl[slot];
+    s->cx = 0.5 * (ctx->cfg.width - 1);
+    s->cy = 0.5 * (ctx->cfg.height - 1);
+    s->f = 0.5 * (ctx->cfg.width > ctx->cfg.height ? ctx->cfg.width : ctx->cfg.height);
+    s->img_b = scratch;
+    s->img_b2 = scratch + cap;
+    s->res = scratch + 2 * cap;
+    s->wt = scratch + 3 * cap;
+    s->alpha = 1.0;
+    s->hessian_level = -1;
+    s->k = 8;
+    for (s->finest = st->finest_level; s->finest < st->levels - 1; s->finest++)
+        if (s->tpl[s->finest].n >= FINEST_MIN_POINTS) break;
+}
+
+/* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid.
+ * Writes the refined H and fills the refine fields of result. */
+void home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)
+{
+    const home__refine_state *st = &ctx->refine;
+    home__refine_solver s;
+    double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0, refined_std;
+    double noise_std = -1.0;
+    int level, it, converged = 0, iterations = 0;
+    const double max_std =
+        MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
+
+    home__refine_solver_setup(ctx, slot, &s);
+    /* below a homography the update stays in the model (it is a group: I + D(dp) in it keeps
+     * the estimate in it), so a few edges that leave a homography undetermined still fix it */
+    s.k = 8;
+    if (ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY) {
+        double o[8];
+        s.k = home__model_basis(HOME__SPACE_H, ctx->cfg.max_model, o, s.basis);
+    }
+    home__refine_to_normalised(&s, h0, hn0);
+    memcpy(s.hn, hn0, sizeof hn0);
+    for (level = s.finest; level < st->levels; level++) {
+        if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return; }
+    }
+    for (level = st->levels - 1; level >= s.finest; level--) {
+        double last_step = INFINITY;
+        converged = 0;
+        for (it = 0; it < ctx->cfg.refine_iterations; it++) {
+            iterations++;
+            if (!iterate(&s, level, &step)) {
+                result->refine_iterations = iterations;
+                result->refine_status = HOME_REFINE_FEW_POINTS;
+                return;
+            }
+            if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
+            /* at the finest level, also a step far below the estimate's own predicted
+             * uncertainty: noisy frames (low light) keep the steps jittering at that scale */
+            if (level == s.finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
+                if (!(noise_std >= 0.0)) { /* predicted once, near the optimum */
+                    s.resid_var = residual_variance(&s);
+                    noise_std = corner_std_px(&s);
+                }
+                if (step < STEP_NOISE_SHARE * noise_std) { converged = 1; break; }
+            }
+            /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
+            if (step > 0.5 * last_step) s.hessian_level = -1;
+            last_step = step;
+        }
+    }
+    result->refine_iterations = iterations;
+    if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return; }
+    to_pixels(&s, s.hn, h1);
+    s.resid_var = residual_variance(&s);
+    refined_std = corner_std_px(&s);
+    if (refined_std > max_std || !(s.split_px <= max_std)) {
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return;
+    }
+    /* the same plausibility HOME's estimate passed: a refinement that slid towards a singular
+     * H (a frame squeezed to a line keeps the photometric error low on flat content) is no
+     * estimate (fuzz_api found one: tests/fuzz/corpus/api/regress-refined-singular-h) */
+    if (!home__homography_plausible(h1, ctx->cfg.width, ctx->cfg.height)) {
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return;
+    }
+    /* like for like: both estimates over the points both keep, at the scale of HOME's */
+    {
+        const int fl = s.finest;
+        const home__refine_points *tp = &s.tpl[fl];
+        const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+        float m[9];
+        home__refine_level_matrix(&s, s.hn, fl, m);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
+        home__refine_level_matrix(&s, hn0, fl, m);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
+        s.alpha = 1.0;
+        s.beta = 0.0;
+        home__refine_fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
+        sigma0 = home__refine_robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta,
+                                           (int32_t *)(void *)s.wt);
+        e0 = photometric_error(&s, s.img_b, s.img_b2, sigma0, &zncc0);
+        e1 = photometric_error(&s, s.img_b2, s.img_b, sigma0, &zncc1);
+        result->refine_inlier_share = inlier_share(&s, s.img_b2, s.img_b);
+    }
+    result->refine_error[0] = e0;
+    result->refine_error[1] = e1;
+    result->refine_zncc = zncc1;
+    /* not lower: a divergence, or (noisy frames) the start was already the optimum within the
+     * refined estimate's own uncertainty, which then stands */
+    if (!(e1 < e0) &&
+        !(home__refine_max_corner_distance(s.cx, s.cy, h1, h0) <= 3.0 * refined_std)) {
+        result->refine_status = HOME_REFINE_NOT_LOWER;
+        return;
+    }
+    if (!choose_model(&s, ctx->cfg.max_model, h1, result)) {
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return;
+    }
+    memcpy(result->H, h1, sizeof h1);
+    result->refined = 1;
+    result->refine_status = HOME_REFINE_ACCEPTED;
+}
