@@ -5,7 +5,7 @@ STAB_SUPPORT := $(BUILD)/obj/examples/y4m.o $(BUILD)/obj/examples/stab_png.o $(B
 BINS += $(BUILD)/bin/home-stab $(BUILD)/bin/home-stab-clip $(BUILD)/bin/home-stab-tests
 TEST_BINS += $(BUILD)/bin/home-stab-tests
 
-$(BUILD)/obj/src/stabilise.o $(BUILD)/obj/src/warp.o $(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/stab_*.c)): include/home_stab.h port/stab_kernels.h port/stab_x86.h
+$(BUILD)/obj/src/stabilise.o $(BUILD)/obj/src/stab_motion.o $(BUILD)/obj/src/stab_path.o $(BUILD)/obj/src/warp.o $(patsubst port/%.c,$(BUILD)/obj/port/%.o,$(wildcard port/stab_*.c)): include/home_stab.h port/stab_kernels.h port/stab_x86.h
 $(BUILD)/obj/port/stab_avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 
 $(BUILD)/bin/home-stab: $(BUILD)/obj/examples/home-stab.o $(STAB_SUPPORT) $(LIB)
@@ -81,3 +81,4 @@ BINS += $(BUILD)/bin/home-warp-bands
 $(BUILD)/bin/home-warp-bands: bench/stab/warp_bands.c $(LIB) include/home_stab.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $< $(LIB) -o $@ $(LDFLAGS_APP) -pthread
+$(BUILD)/obj/src/stabilise.o $(BUILD)/obj/src/stab_motion.o $(BUILD)/obj/src/stab_path.o: src/stab_state.h

@@ -1,15 +1,16 @@
 /* Live electronic image stabilisation on HOME registration: camera path from per-frame
  * similarities, constant-velocity Kalman filter plus fixed-lag RTS smoothing over the lookahead,
- * crop-window constraint, hold-on-failure. See include/home_stab.h for the contract. */
+ * crop-window constraint, hold-on-failure. See include/home_stab.h for the contract. This file:
+ * configuration and arena, frames in (registration at the chosen size) and out (the crop
+ * window); the similarities are in stab_motion.c, the path's filter in stab_path.c. */
 #include "home_stab.h"
 #include "kernels.h"
 #include "stab_kernels.h"
+#include "stab_state.h"
 #include <math.h>
 #include <string.h>
 
 #define STAB_MAGIC 0x48535442u            /* "HSTB" */
-#define STAB_INIT_VEL_VAR 1.0             /* prior variance of the path velocity, (px/frame)^2 */
-#define STAB_FIT_GRID 5                   /* similarity fitted to H on a 5x5 grid of the frame */
 #define STAB_BISECT_STEPS 30
 #define STAB_THETA_BINS 88                /* HOME's automatic theta bins for video registration */
 #define STAB_REFINE_POINTS 1024           /* HOME's refinement template points at full size */
@@ -18,34 +19,6 @@
  * pulls the path less; beyond STAB_MAX_SIGMA_PX the frame holds the path. */
 #define STAB_SIGMA_REF_PX 0.5
 #define STAB_MAX_SIGMA_PX 4.0
-
-/* One frame of path history. Path components are normalised to pixels (angle and log scale
- * times the half diagonal) so that one filter covariance serves all four of them. */
-typedef struct stab_slot {
-    long frame;
-    int status;
-    double weight;                /* measurement noise factor (1: an exact motion) */
-    home_stab_sim raw;            /* camera path: frame 0 -> this frame */
-    double xf[4][2], xp[4][2];    /* filtered / predicted (position, velocity) per component */
-    double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
-} stab_slot;
-
-struct home_stab {
-    uint32_t magic;
-    home_stab_config cfg;
-    home_context *home;
-    home_features *feat[2];       /* [0] previous frame, [1] current: swapped by pointer */
-    uint8_t *small;               /* downscaled luma */
-    int small_w, small_h;
-    /* HOME's box downscale of planar rows (its backend's): the same rounding as the reference
-     * loop in registration_luma() */
-    void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
-    stab_slot *ring;              /* 2 lookahead + 1 slots, frame n in ring[n % len] */
-    int ring_len;
-    long pushed, emitted;
-    int tail;                     /* flush has appended the mirrored frames after the last one */
-    double q, r, norm;            /* process / measurement noise, px per radian or log-scale */
-};
 
 /* The smoothing time constant in frames. Automatic (0): with a lookahead of N frames the fixed-lag
  * smoother needs a lag of about twice the time constant to reach the full smoother's response,
@@ -63,9 +36,15 @@ static double stab_time_constant(const home_stab_config *cfg)
     return cfg->lookahead / 2.0 < 3.0 ? 3.0 : cfg->lookahead / 2.0;
 }
 
-static size_t align_up(size_t n) { return (n + HOME_ARENA_ALIGN - 1) / HOME_ARENA_ALIGN * HOME_ARENA_ALIGN; }
+static size_t align_up(size_t n)
+{
+    return (n + HOME_ARENA_ALIGN - 1) / HOME_ARENA_ALIGN * HOME_ARENA_ALIGN;
+}
 
-static int is_finite_in(double v, double lo, double hi) { return isfinite(v) && v >= lo && v <= hi; }
+static int is_finite_in(double v, double lo, double hi)
+{
+    return isfinite(v) && v >= lo && v <= hi;
+}
 
 int home_stab_default_config(home_stab_config *cfg, int width, int height)
 {
@@ -151,8 +130,8 @@ int home_stab_validate_config(const home_stab_config *cfg)
         return HOME_E_SIZE;
     if (!is_finite_in(cfg->margin, 0.0, 0.4) ||
         !(cfg->smoothing == 0.0f || is_finite_in(cfg->smoothing, 1.0, 1000.0)) ||
-        cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD || !is_finite_in(cfg->ease, 0.0, 1.0) ||
-        (cfg->refine != 0 && cfg->refine != 1) ||
+        cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD ||
+        !is_finite_in(cfg->ease, 0.0, 1.0) || (cfg->refine != 0 && cfg->refine != 1) ||
         (cfg->refine_finest_level != 0 && cfg->refine_finest_level != 1) ||
         !is_finite_in(cfg->max_shift, 0.0, 1.0) || !is_finite_in(cfg->max_rotation, 0.0, 1.6) ||
         !is_finite_in(cfg->max_zoom, 0.0, 1.0) || !is_finite_in(cfg->max_residual, 0.0, 1e6))
@@ -240,97 +219,6 @@ int home_stab_reset(home_stab *st)
     return HOME_OK;
 }
 
-/* ---- similarities about the frame centre ---- */
-
-/* b after a */
-static home_stab_sim sim_compose(const home_stab_sim *b, const home_stab_sim *a)
-{
-    home_stab_sim r;
-    double s = exp(b->log_scale), c = cos(b->angle), n = sin(b->angle);
-    r.angle = a->angle + b->angle;
-    r.log_scale = a->log_scale + b->log_scale;
-    r.tx = s * (c * a->tx - n * a->ty) + b->tx;
-    r.ty = s * (n * a->tx + c * a->ty) + b->ty;
-    return r;
-}
-
-static home_stab_sim sim_inverse(const home_stab_sim *a)
-{
-    home_stab_sim r;
-    double s = exp(-a->log_scale), c = cos(a->angle), n = sin(a->angle);
-    r.angle = -a->angle;
-    r.log_scale = -a->log_scale;
-    r.tx = -s * (c * a->tx + n * a->ty);
-    r.ty = -s * (-n * a->tx + c * a->ty);
-    return r;
-}
-
-static home_stab_sim sim_scaled(const home_stab_sim *a, double k)
-{
-    home_stab_sim r;
-    r.tx = k * a->tx; r.ty = k * a->ty; r.angle = k * a->angle; r.log_scale = k * a->log_scale;
-    return r;
-}
-
-void home_stab_sim_to_matrix(const home_stab_sim *s, int width, int height, double *m)
-{
-    double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
-    double k = exp(s->log_scale), a = k * cos(s->angle), b = k * sin(s->angle);
-    m[0] = a; m[1] = -b; m[2] = cx + s->tx - a * cx + b * cy;
-    m[3] = b; m[4] = a;  m[5] = cy + s->ty - b * cx - a * cy;
-    m[6] = 0; m[7] = 0;  m[8] = 1;
-}
-
-static void apply(const double *h, double x, double y, double *u, double *v)
-{
-    double w = h[6] * x + h[7] * y + h[8];
-    *u = (h[0] * x + h[1] * y + h[2]) / w;
-    *v = (h[3] * x + h[4] * y + h[5]) / w;
-}
-
-/* Least-squares similarity through the points a grid of the full frame reaches under HOME's H
- * (found on the downscaled frame). Returns the RMS residual in px, or -1 if H is unusable. */
-static double fit_similarity(const home_stab *st, const double *h, home_stab_sim *out)
-{
-    const double f = st->cfg.downscale, off = 0.5 * (f - 1);
-    const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
-    double px[STAB_FIT_GRID * STAB_FIT_GRID][2], qx[STAB_FIT_GRID * STAB_FIT_GRID][2];
-    double mp[2] = {0, 0}, mq[2] = {0, 0}, spp = 0, sa = 0, sb = 0, a, b, res = 0;
-    const int n = STAB_FIT_GRID * STAB_FIT_GRID;
-    int i, j, k = 0;
-    for (j = 0; j < STAB_FIT_GRID; j++)
-        for (i = 0; i < STAB_FIT_GRID; i++, k++) {
-            double x = (st->cfg.width - 1) * (double)i / (STAB_FIT_GRID - 1);
-            double y = (st->cfg.height - 1) * (double)j / (STAB_FIT_GRID - 1);
-            double w = h[6] * (x - off) / f + h[7] * (y - off) / f + h[8], u, v;
-            if (!(w > 1e-6)) return -1.0;   /* grid point crosses the horizon of H */
-            apply(h, (x - off) / f, (y - off) / f, &u, &v);
-            px[k][0] = x - cx; px[k][1] = y - cy;
-            qx[k][0] = f * u + off - cx; qx[k][1] = f * v + off - cy;
-            mp[0] += px[k][0]; mp[1] += px[k][1]; mq[0] += qx[k][0]; mq[1] += qx[k][1];
-        }
-    mp[0] /= n; mp[1] /= n; mq[0] /= n; mq[1] /= n;
-    for (k = 0; k < n; k++) {
-        double p0 = px[k][0] - mp[0], p1 = px[k][1] - mp[1], q0 = qx[k][0] - mq[0], q1 = qx[k][1] - mq[1];
-        spp += p0 * p0 + p1 * p1;
-        sa += p0 * q0 + p1 * q1;
-        sb += p0 * q1 - p1 * q0;
-    }
-    a = sa / spp;
-    b = sb / spp;
-    if (!(a * a + b * b > 1e-12) || !isfinite(a) || !isfinite(b)) return -1.0;
-    out->angle = atan2(b, a);
-    out->log_scale = 0.5 * log(a * a + b * b);
-    out->tx = mq[0] - (a * mp[0] - b * mp[1]);
-    out->ty = mq[1] - (b * mp[0] + a * mp[1]);
-    for (k = 0; k < n; k++) {
-        double u = a * px[k][0] - b * px[k][1] + out->tx - qx[k][0];
-        double v = b * px[k][0] + a * px[k][1] + out->ty - qx[k][1];
-        res += u * u + v * v;
-    }
-    return sqrt(res / n);
-}
-
 /* Box-average the frame's luma into st->small; returns the image registration reads. */
 static const uint8_t *registration_luma(home_stab *st, const home_stab_image *im, ptrdiff_t *stride)
 {
@@ -355,159 +243,11 @@ static const uint8_t *registration_luma(home_stab *st, const home_stab_image *im
                 const uint8_t *row = y + (ptrdiff_t)(j * f + b) * im->stride[0];
                 for (a = 0; a < f; a++) sum += row[(ptrdiff_t)(i * f + a) * step];
             }
-            st->small[(ptrdiff_t)j * st->small_w + i] = (uint8_t)((sum + (unsigned)(f * f / 2)) / (unsigned)(f * f));
+            st->small[(ptrdiff_t)j * st->small_w + i] =
+                (uint8_t)((sum + (unsigned)(f * f / 2)) / (unsigned)(f * f));
         }
     *stride = st->small_w;
     return st->small;
-}
-
-/* ---- path filter ---- */
-
-static void path_components(const home_stab *st, const home_stab_sim *s, double *z)
-{
-    z[0] = s->tx; z[1] = s->ty; z[2] = s->angle * st->norm; z[3] = s->log_scale * st->norm;
-}
-
-/* One filter step for cur, measuring z (path components). */
-static void kalman_step(const home_stab *st, const stab_slot *prev, stab_slot *cur, const double *z)
-{
-    double k0, k1, sv;
-    int c;
-    if (!prev) {
-        for (c = 0; c < 4; c++) {
-            cur->xp[c][0] = cur->xf[c][0] = z[c];
-            cur->xp[c][1] = cur->xf[c][1] = 0.0;
-        }
-        cur->pp[0] = cur->pf[0] = st->r;
-        cur->pp[1] = cur->pf[1] = 0.0;
-        cur->pp[2] = cur->pf[2] = STAB_INIT_VEL_VAR;
-        return;
-    }
-    /* predict with F = [1 1; 0 1], Q = q [1/3 1/2; 1/2 1] (white acceleration, one frame) */
-    cur->pp[0] = prev->pf[0] + 2.0 * prev->pf[1] + prev->pf[2] + st->q / 3.0;
-    cur->pp[1] = prev->pf[1] + prev->pf[2] + st->q / 2.0;
-    cur->pp[2] = prev->pf[2] + st->q;
-    sv = cur->pp[0] + st->r * cur->weight;
-    k0 = cur->pp[0] / sv;
-    k1 = cur->pp[1] / sv;
-    for (c = 0; c < 4; c++) {
-        double innov;
-        cur->xp[c][0] = prev->xf[c][0] + prev->xf[c][1];
-        cur->xp[c][1] = prev->xf[c][1];
-        innov = z[c] - cur->xp[c][0];
-        cur->xf[c][0] = cur->xp[c][0] + k0 * innov;
-        cur->xf[c][1] = cur->xp[c][1] + k1 * innov;
-    }
-    cur->pf[0] = (1.0 - k0) * cur->pp[0];
-    cur->pf[1] = (1.0 - k0) * cur->pp[1];
-    cur->pf[2] = cur->pp[2] - k1 * cur->pp[1];
-}
-
-static stab_slot *slot_of(const home_stab *st, long frame) { return &st->ring[frame % st->ring_len]; }
-
-/* The stream's ends. With a lookahead, the path before frame 0 and after the last frame is taken
- * to be the path inside the stream mirrored about the end frame, plus the share 1 - ease of its
- * linear trend (ease 0: the pan goes on, 1: the camera comes to rest). The first and last
- * lookahead frames are then smoothed over a full window like the others instead of over a
- * one-sided one, and with ease > 0 the virtual camera eases in and out of the pan over about a
- * lookahead of frames: on the bench clips the ends' ITF loss was that speed, not jitter (see
- * bench/stab/README.md). Latency is unchanged: the start is re-filtered when frame `lookahead`
- * arrives, before frame 0 is due; the end is appended at flush. */
-
-/* Least-squares slope (path components per frame) over frames a..b. */
-static void path_trend(const home_stab *st, long a, long b, double *v)
-{
-    double z[4], sz[4] = {0, 0, 0, 0}, tm = 0.5 * (double)(a + b), stt = 0.0;
-    long t;
-    int c;
-    for (t = a; t <= b; t++) {
-        path_components(st, &slot_of(st, t)->raw, z);
-        stt += (t - tm) * (t - tm);
-        for (c = 0; c < 4; c++) sz[c] += (t - tm) * z[c];
-    }
-    for (c = 0; c < 4; c++) v[c] = stt > 0.0 ? sz[c] / stt : 0.0;
-}
-
-/* The measurement taken for frame t outside 0..last: the frame t is reflected to (again and
- * again for streams shorter than the lookahead), plus the kept trend over the distance. */
-static void mirrored_measurement(const home_stab *st, long t, long last, const double *trend, double *z)
-{
-    const double keep = 1.0 - st->cfg.ease;
-    long r = t;
-    int c;
-    while (last > 0 && (r < 0 || r > last)) r = r < 0 ? -r : 2 * last - r;
-    if (last == 0) r = 0;
-    path_components(st, &slot_of(st, r)->raw, z);
-    for (c = 0; c < 4; c++) z[c] += keep * trend[c] * (double)(t - r);
-}
-
-/* Re-run the filter over frames 0..last (all in the ring) after the mirrored frames -k..-1,
- * k = min(lookahead, last). */
-static void refilter_mirrored_start(const home_stab *st, long last)
-{
-    const long k = last < st->cfg.lookahead ? last : st->cfg.lookahead;
-    stab_slot v[2];
-    const stab_slot *prev = NULL;
-    double trend[4], z[4];
-    long i;
-    if (k <= 0) return;
-    v[0].weight = v[1].weight = 1.0;
-    path_trend(st, 0, k, trend);
-    for (i = -k; i <= last; i++) {
-        stab_slot *cur = i < 0 ? &v[i & 1] : slot_of(st, i);
-        if (i < 0) mirrored_measurement(st, i, last, trend, z);
-        else path_components(st, &cur->raw, z);
-        kalman_step(st, prev, cur, z);
-        prev = cur;
-    }
-}
-
-/* Append the mirrored frames last+1..last+lookahead. The ring has 2 lookahead + 1 slots: frame
- * last+i takes the slot of frame last+i-ring_len, older than every frame mirrored or still due. */
-static void append_mirrored_end(home_stab *st, long last)
-{
-    const long k = last < st->cfg.lookahead ? last : st->cfg.lookahead;
-    double trend[4], z[4];
-    long i;
-    path_trend(st, last - k, last, trend);
-    for (i = 1; i <= st->cfg.lookahead; i++) {
-        stab_slot *cur = slot_of(st, last + i);
-        mirrored_measurement(st, last + i, last, trend, z);
-        cur->frame = last + i;
-        cur->status = HOME_STAB_MOTION_OK;
-        cur->weight = 1.0;
-        kalman_step(st, slot_of(st, last + i - 1), cur, z);
-    }
-    st->tail = 1;
-}
-
-/* Fixed-lag RTS smoothing: the estimate of frame m's path given every frame up to last. */
-static home_stab_sim smoothed_path(const home_stab *st, long m, long last)
-{
-    double xs[4][2];
-    home_stab_sim s;
-    long k;
-    int c;
-    memcpy(xs, slot_of(st, last)->xf, sizeof xs);
-    for (k = last - 1; k >= m; k--) {
-        const stab_slot *a = slot_of(st, k), *b = slot_of(st, k + 1);
-        /* C = Pf F^T Pp(k+1)^-1 */
-        double f00 = a->pf[0] + a->pf[1], f01 = a->pf[1], f10 = a->pf[1] + a->pf[2], f11 = a->pf[2];
-        double det = b->pp[0] * b->pp[2] - b->pp[1] * b->pp[1];
-        double i00 = b->pp[2] / det, i01 = -b->pp[1] / det, i11 = b->pp[0] / det;
-        double c00 = f00 * i00 + f01 * i01, c01 = f00 * i01 + f01 * i11;
-        double c10 = f10 * i00 + f11 * i01, c11 = f10 * i01 + f11 * i11;
-        for (c = 0; c < 4; c++) {
-            double d0 = xs[c][0] - b->xp[c][0], d1 = xs[c][1] - b->xp[c][1];
-            xs[c][0] = a->xf[c][0] + c00 * d0 + c01 * d1;
-            xs[c][1] = a->xf[c][1] + c10 * d0 + c11 * d1;
-        }
-    }
-    s.tx = xs[0][0];
-    s.ty = xs[1][0];
-    s.angle = xs[2][0] / st->norm;
-    s.log_scale = xs[3][0] / st->norm;
-    return s;
 }
 
 /* output pixel -> input pixel for a correction (virtual camera -> real camera) share k */
@@ -515,7 +255,7 @@ static void crop_warp(const home_stab *st, const home_stab_sim *corr, double k, 
 {
     const double z = 1.0 - 2.0 * st->cfg.margin;
     const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
-    home_stab_sim part = sim_scaled(corr, k);
+    home_stab_sim part = home__stab_sim_scaled(corr, k);
     double d[9];
     int i;
     home_stab_sim_to_matrix(&part, st->cfg.width, st->cfg.height, d);
@@ -534,7 +274,7 @@ static int window_inside(const home_stab *st, const double *m)
     int i;
     for (i = 0; i < 4; i++) {
         double x = (i & 1) ? xmax : 0.0, y = (i & 2) ? ymax : 0.0, u, v;
-        apply(m, x, y, &u, &v);
+        home__stab_apply(m, x, y, &u, &v);
         if (!(u >= 0.0 && u <= xmax && v >= 0.0 && v <= ymax)) return 0;
     }
     return 1;
@@ -551,10 +291,10 @@ static void emit(home_stab *st, long last, home_stab_output *out)
     out->frame = m;
     out->raw = slot->raw;
     out->motion_status = slot->status;
-    out->smooth = smoothed_path(st, m, last);
+    out->smooth = home__stab_smoothed_path(st, m, last);
     /* the real camera seen from the virtual (smoothed) one: raw after smooth^-1 */
-    inv_smooth = sim_inverse(&out->smooth);
-    corr = sim_compose(&slot->raw, &inv_smooth);
+    inv_smooth = home__stab_sim_inverse(&out->smooth);
+    corr = home__stab_sim_compose(&slot->raw, &inv_smooth);
     crop_warp(st, &corr, 1.0, out->warp);
     if (!window_inside(st, out->warp)) {
         /* the largest share of the correction that keeps the window inside (0 always does) */
@@ -603,8 +343,9 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
         if (status != HOME_OK) return status;
         out->newest_status = HOME_STAB_MOTION_FAILED;
         if (out->reg.ok) {
-            home_stab_sim s = {0, 0, 0, 0}; /* fit_similarity() fills it when it returns >= 0 */
-            double res = fit_similarity(st, out->reg.H, &s);
+            /* home__stab_fit_similarity() fills s when it returns >= 0 */
+            home_stab_sim s = {0, 0, 0, 0};
+            double res = home__stab_fit_similarity(st, out->reg.H, &s);
             out->newest_status = HOME_STAB_MOTION_IMPLAUSIBLE;
             if (res >= 0.0 && res <= st->cfg.max_residual &&
                 hypot(s.tx, s.ty) <= st->cfg.max_shift * st->cfg.width &&
@@ -627,17 +368,17 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     slot->weight = weight;
     if (n == 0) {
         memset(&slot->raw, 0, sizeof slot->raw);
-        path_components(st, &slot->raw, z);
-        kalman_step(st, NULL, slot, z);
+        home__stab_path_components(st, &slot->raw, z);
+        home__stab_kalman_step(st, NULL, slot, z);
     } else {
         const stab_slot *prev = slot_of(st, n - 1);
-        slot->raw = sim_compose(&motion, &prev->raw);
-        path_components(st, &slot->raw, z);
-        kalman_step(st, prev, slot, z);
+        slot->raw = home__stab_sim_compose(&motion, &prev->raw);
+        home__stab_path_components(st, &slot->raw, z);
+        home__stab_kalman_step(st, prev, slot, z);
     }
     st->pushed = n + 1;
     st->tail = 0;
-    if (n == st->cfg.lookahead) refilter_mirrored_start(st, n);
+    if (n == st->cfg.lookahead) home__stab_refilter_mirrored_start(st, n);
     if (n - st->emitted >= st->cfg.lookahead) emit(st, n, out);
     return HOME_OK;
 }
@@ -649,8 +390,9 @@ int home_stab_flush(home_stab *st, home_stab_output *out)
     memset(out, 0, sizeof *out);
     if (st->emitted >= st->pushed) return HOME_OK;
     if (!st->tail) {
-        if (st->pushed - 1 < st->cfg.lookahead) refilter_mirrored_start(st, st->pushed - 1);
-        append_mirrored_end(st, st->pushed - 1);
+        if (st->pushed - 1 < st->cfg.lookahead)
+            home__stab_refilter_mirrored_start(st, st->pushed - 1);
+        home__stab_append_mirrored_end(st, st->pushed - 1);
     }
     emit(st, st->emitted + st->cfg.lookahead, out);
     return HOME_OK;

@@ -1,0 +1,153 @@
+/* The camera path: a constant-velocity Kalman filter per component, fixed-lag RTS smoothing
+ * over the lookahead, and the stream's ends mirrored so that they are smoothed like the rest. */
+#include "stab_state.h"
+#include <string.h>
+
+#define STAB_INIT_VEL_VAR 1.0             /* prior variance of the path velocity, (px/frame)^2 */
+
+void home__stab_path_components(const home_stab *st, const home_stab_sim *s, double *z)
+{
+    z[0] = s->tx; z[1] = s->ty; z[2] = s->angle * st->norm; z[3] = s->log_scale * st->norm;
+}
+
+/* One filter step for cur, measuring z (path components). */
+void home__stab_kalman_step(const home_stab *st, const stab_slot *prev, stab_slot *cur,
+                            const double *z)
+{
+    double k0, k1, sv;
+    int c;
+    if (!prev) {
+        for (c = 0; c < 4; c++) {
+            cur->xp[c][0] = cur->xf[c][0] = z[c];
+            cur->xp[c][1] = cur->xf[c][1] = 0.0;
+        }
+        cur->pp[0] = cur->pf[0] = st->r;
+        cur->pp[1] = cur->pf[1] = 0.0;
+        cur->pp[2] = cur->pf[2] = STAB_INIT_VEL_VAR;
+        return;
+    }
+    /* predict with F = [1 1; 0 1], Q = q [1/3 1/2; 1/2 1] (white acceleration, one frame) */
+    cur->pp[0] = prev->pf[0] + 2.0 * prev->pf[1] + prev->pf[2] + st->q / 3.0;
+    cur->pp[1] = prev->pf[1] + prev->pf[2] + st->q / 2.0;
+    cur->pp[2] = prev->pf[2] + st->q;
+    sv = cur->pp[0] + st->r * cur->weight;
+    k0 = cur->pp[0] / sv;
+    k1 = cur->pp[1] / sv;
+    for (c = 0; c < 4; c++) {
+        double innov;
+        cur->xp[c][0] = prev->xf[c][0] + prev->xf[c][1];
+        cur->xp[c][1] = prev->xf[c][1];
+        innov = z[c] - cur->xp[c][0];
+        cur->xf[c][0] = cur->xp[c][0] + k0 * innov;
+        cur->xf[c][1] = cur->xp[c][1] + k1 * innov;
+    }
+    cur->pf[0] = (1.0 - k0) * cur->pp[0];
+    cur->pf[1] = (1.0 - k0) * cur->pp[1];
+    cur->pf[2] = cur->pp[2] - k1 * cur->pp[1];
+}
+
+/* The stream's ends. With a lookahead, the path before frame 0 and after the last frame is taken
+ * to be the path inside the stream mirrored about the end frame, plus the share 1 - ease of its
+ * linear trend (ease 0: the pan goes on, 1: the camera comes to rest). The first and last
+ * lookahead frames are then smoothed over a full window like the others instead of over a
+ * one-sided one, and with ease > 0 the virtual camera eases in and out of the pan over about a
+ * lookahead of frames: on the bench clips the ends' ITF loss was that speed, not jitter (see
+ * bench/stab/README.md). Latency is unchanged: the start is re-filtered when frame `lookahead`
+ * arrives, before frame 0 is due; the end is appended at flush. */
+
+/* Least-squares slope (path components per frame) over frames a..b. */
+static void path_trend(const home_stab *st, long a, long b, double *v)
+{
+    double z[4], sz[4] = {0, 0, 0, 0}, tm = 0.5 * (double)(a + b), stt = 0.0;
+    long t;
+    int c;
+    for (t = a; t <= b; t++) {
+        home__stab_path_components(st, &slot_of(st, t)->raw, z);
+        stt += (t - tm) * (t - tm);
+        for (c = 0; c < 4; c++) sz[c] += (t - tm) * z[c];
+    }
+    for (c = 0; c < 4; c++) v[c] = stt > 0.0 ? sz[c] / stt : 0.0;
+}
+
+/* The measurement taken for frame t outside 0..last: the frame t is reflected to (again and
+ * again for streams shorter than the lookahead), plus the kept trend over the distance. */
+static void mirrored_measurement(const home_stab *st, long t, long last, const double *trend,
+                                 double *z)
+{
+    const double keep = 1.0 - st->cfg.ease;
+    long r = t;
+    int c;
+    while (last > 0 && (r < 0 || r > last)) r = r < 0 ? -r : 2 * last - r;
+    if (last == 0) r = 0;
+    home__stab_path_components(st, &slot_of(st, r)->raw, z);
+    for (c = 0; c < 4; c++) z[c] += keep * trend[c] * (double)(t - r);
+}
+
+/* Re-run the filter over frames 0..last (all in the ring) after the mirrored frames -k..-1,
+ * k = min(lookahead, last). */
+void home__stab_refilter_mirrored_start(const home_stab *st, long last)
+{
+    const long k = last < st->cfg.lookahead ? last : st->cfg.lookahead;
+    stab_slot v[2];
+    const stab_slot *prev = NULL;
+    double trend[4], z[4];
+    long i;
+    if (k <= 0) return;
+    v[0].weight = v[1].weight = 1.0;
+    path_trend(st, 0, k, trend);
+    for (i = -k; i <= last; i++) {
+        stab_slot *cur = i < 0 ? &v[i & 1] : slot_of(st, i);
+        if (i < 0) mirrored_measurement(st, i, last, trend, z);
+        else home__stab_path_components(st, &cur->raw, z);
+        home__stab_kalman_step(st, prev, cur, z);
+        prev = cur;
+    }
+}
+
+/* Append the mirrored frames last+1..last+lookahead. The ring has 2 lookahead + 1 slots: frame
+ * last+i takes the slot of frame last+i-ring_len, older than every frame mirrored or still due. */
+void home__stab_append_mirrored_end(home_stab *st, long last)
+{
+    const long k = last < st->cfg.lookahead ? last : st->cfg.lookahead;
+    double trend[4], z[4];
+    long i;
+    path_trend(st, last - k, last, trend);
+    for (i = 1; i <= st->cfg.lookahead; i++) {
+        stab_slot *cur = slot_of(st, last + i);
+        mirrored_measurement(st, last + i, last, trend, z);
+        cur->frame = last + i;
+        cur->status = HOME_STAB_MOTION_OK;
+        cur->weight = 1.0;
+        home__stab_kalman_step(st, slot_of(st, last + i - 1), cur, z);
+    }
+    st->tail = 1;
+}
+
+/* Fixed-lag RTS smoothing: the estimate of frame m's path given every frame up to last. */
+home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last)
+{
+    double xs[4][2];
+    home_stab_sim s;
+    long k;
+    int c;
+    memcpy(xs, slot_of(st, last)->xf, sizeof xs);
+    for (k = last - 1; k >= m; k--) {
+        const stab_slot *a = slot_of(st, k), *b = slot_of(st, k + 1);
+        /* C = Pf F^T Pp(k+1)^-1 */
+        double f00 = a->pf[0] + a->pf[1], f01 = a->pf[1], f10 = a->pf[1] + a->pf[2], f11 = a->pf[2];
+        double det = b->pp[0] * b->pp[2] - b->pp[1] * b->pp[1];
+        double i00 = b->pp[2] / det, i01 = -b->pp[1] / det, i11 = b->pp[0] / det;
+        double c00 = f00 * i00 + f01 * i01, c01 = f00 * i01 + f01 * i11;
+        double c10 = f10 * i00 + f11 * i01, c11 = f10 * i01 + f11 * i11;
+        for (c = 0; c < 4; c++) {
+            double d0 = xs[c][0] - b->xp[c][0], d1 = xs[c][1] - b->xp[c][1];
+            xs[c][0] = a->xf[c][0] + c00 * d0 + c01 * d1;
+            xs[c][1] = a->xf[c][1] + c10 * d0 + c11 * d1;
+        }
+    }
+    s.tx = xs[0][0];
+    s.ty = xs[1][0];
+    s.angle = xs[2][0] / st->norm;
+    s.log_scale = xs[3][0] / st->norm;
+    return s;
+}

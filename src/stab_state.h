@@ -1,0 +1,58 @@
+/* The stabiliser's state, shared by its files: stabilise.c (configuration, frames in and
+ * out, the crop), stab_motion.c (similarities about the frame centre) and stab_path.c (the
+ * camera path's Kalman filter, fixed-lag smoother and mirrored stream ends). */
+#ifndef HOME_STAB_STATE_H
+#define HOME_STAB_STATE_H
+
+#include "home_stab.h"
+
+/* One frame of path history. Path components are normalised to pixels (angle and log scale
+ * times the half diagonal) so that one filter covariance serves all four of them. */
+typedef struct stab_slot {
+    long frame;
+    int status;
+    double weight;                /* measurement noise factor (1: an exact motion) */
+    home_stab_sim raw;            /* camera path: frame 0 -> this frame */
+    double xf[4][2], xp[4][2];    /* filtered / predicted (position, velocity) per component */
+    double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
+} stab_slot;
+
+struct home_stab {
+    uint32_t magic;
+    home_stab_config cfg;
+    home_context *home;
+    home_features *feat[2];       /* [0] previous frame, [1] current: swapped by pointer */
+    uint8_t *small;               /* downscaled luma */
+    int small_w, small_h;
+    /* HOME's box downscale of planar rows (its backend's): the same rounding as the reference
+     * loop in registration_luma() */
+    void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
+    stab_slot *ring;              /* 2 lookahead + 1 slots, frame n in ring[n % len] */
+    int ring_len;
+    long pushed, emitted;
+    int tail;                     /* flush has appended the mirrored frames after the last one */
+    double q, r, norm;            /* process / measurement noise, px per radian or log-scale */
+};
+
+static inline stab_slot *slot_of(const home_stab *st, long frame)
+{
+    return &st->ring[frame % st->ring_len];
+}
+
+/* stab_motion.c */
+/* b after a */
+home_stab_sim home__stab_sim_compose(const home_stab_sim *b, const home_stab_sim *a);
+home_stab_sim home__stab_sim_inverse(const home_stab_sim *a);
+home_stab_sim home__stab_sim_scaled(const home_stab_sim *a, double k);
+void home__stab_apply(const double *h, double x, double y, double *u, double *v);
+double home__stab_fit_similarity(const home_stab *st, const double *h, home_stab_sim *out);
+
+/* stab_path.c */
+void home__stab_path_components(const home_stab *st, const home_stab_sim *s, double *z);
+void home__stab_kalman_step(const home_stab *st, const stab_slot *prev, stab_slot *cur,
+                            const double *z);
+void home__stab_refilter_mirrored_start(const home_stab *st, long last);
+void home__stab_append_mirrored_end(home_stab *st, long last);
+home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last);
+
+#endif
