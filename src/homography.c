@@ -225,7 +225,8 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
         if (t <= cfg->threshold_final) break;
         t = t * 0.5 > cfg->threshold_final ? t * 0.5 : cfg->threshold_final;
     }
-    n_in = ctx->kernels->line_fit->select_inliers(&lp, n_matches, g, cfg->threshold_final, ctx->inlier_index);
+    n_in = ctx->kernels->line_fit->select_inliers(&lp, n_matches, g, cfg->threshold_final,
+                                                  ctx->inlier_index);
     result->inliers = n_in;
     result->model = HOME_MODEL_HOMOGRAPHY;
     result->sigma_px = INFINITY;
@@ -252,7 +253,10 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
             h[2 * 3 + k] = hs[2 * 3 + k];
         }
     }
-    if (!(fabs(h[8]) > 1e-12) || !isfinite(h[8])) { result->failure = HOME_FAIL_DEGENERATE; return HOME_OK; }
+    if (!(fabs(h[8]) > 1e-12) || !isfinite(h[8])) {
+        result->failure = HOME_FAIL_DEGENERATE;
+        return HOME_OK;
+    }
     {
         const double h22 = h[8];
         for (k = 0; k < 9; k++) h[k] /= h22;

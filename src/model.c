@@ -106,8 +106,10 @@ static double corner_rms_distance(const double *ha, const double *hb, const home
     for (c = 0; c < 4; c++) {
         const double u = (c & 1) ? hu : -hu, v = (c & 2) ? hv : -hv;
         const double wa = ha[6] * u + ha[7] * v + 1.0, wb = hb[6] * u + hb[7] * v + 1.0;
-        const double dx = (ha[0] * u + ha[1] * v + ha[2]) / wa - (hb[0] * u + hb[1] * v + hb[2]) / wb;
-        const double dy = (ha[3] * u + ha[4] * v + ha[5]) / wa - (hb[3] * u + hb[4] * v + hb[5]) / wb;
+        const double dx =
+            (ha[0] * u + ha[1] * v + ha[2]) / wa - (hb[0] * u + hb[1] * v + hb[2]) / wb;
+        const double dy =
+            (ha[3] * u + ha[4] * v + ha[5]) / wa - (hb[3] * u + hb[4] * v + hb[5]) / wb;
         sum += dx * dx + dy * dy;
     }
     return mp->scale * sqrt(sum / 4.0);
