@@ -273,7 +273,9 @@ typedef struct home_result {
  * of HOME's H agrees with it: the result is the refined H, ok when HOME's was, or when the
  * photometric fit vouches for it (refine_zncc >= 0.9 and sigma_px <= 0.4 max_sigma_px).
  * Farther away the two disagree: the refined H is the result only when it vouches for the
- * whole frame (also refine_inlier_share >= 0.9), else the pair fails (HOME_FAIL_INCONSISTENT).
+ * whole frame (also refine_inlier_share >= 0.9) and a second refinement, started halfway
+ * between the two, reaches it too (within 3 sigma_px, at least 0.5 px), else the pair fails
+ * (HOME_FAIL_INCONSISTENT).
  * A refinement that cannot converge although the frame has texture refutes HOME's estimate
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the

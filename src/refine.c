@@ -44,6 +44,8 @@
                                  without HOME's confirmation, the tuning set's wrong refined
                                  answers (few edges) predicted 0.44-0.66 px, 95 % of the right
                                  ones less than 0.4 */
+#define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
+                                     within 3 sigma_px or this */
 #define VOUCH_SHARE 0.9      /* ... and, against HOME's estimate or with none, with this share
                                 of its points within 3 robust sigmas */
 
@@ -52,6 +54,22 @@ static double corner_distance(const home_context *ctx, const double *h1, const d
 {
     return home__refine_max_corner_distance(0.5 * (ctx->cfg.width - 1), 0.5 * (ctx->cfg.height - 1),
                                             h1, h2);
+}
+
+/* Does the refinement reach refined's H from halfway between start and it as well? Where the
+ * frame leaves the motion undetermined (a few edges, most through one point), the optimum it
+ * stops at depends on where it starts, and a large move away from HOME's estimate is then no
+ * evidence. */
+static int same_optimum(home_context *ctx, int slot, const double *start,
+                        const home_result *refined)
+{
+    home_result check = *refined;
+    double mid[9], tolerance = 3.0 * refined->sigma_px;
+    int k;
+    for (k = 0; k < 9; k++) mid[k] = 0.5 * (start[k] + refined->H[k]);
+    home__refine_run(ctx, slot, mid, &check);
+    if (tolerance < SAME_OPTIMUM_FLOOR_PX) tolerance = SAME_OPTIMUM_FLOOR_PX;
+    return check.refined && corner_distance(ctx, check.H, refined->H) <= tolerance;
 }
 
 static int find_slot(const home__refine_state *st, uint32_t id)
@@ -117,7 +135,8 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             trial.refine_status = HOME_REFINE_LESS_PRECISE;
             trial.refine_zncc = 0.0;
         } else if (agrees ? result->ok || vouches
-                          : vouches && trial.refine_inlier_share >= VOUCH_SHARE) {
+                          : vouches && trial.refine_inlier_share >= VOUCH_SHARE &&
+                                same_optimum(ctx, slot, result->H, &trial)) {
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
         } else {
