@@ -1,5 +1,7 @@
 # libhome build. `make` builds the library, the CLI and the tests; `make test` runs the suite;
 # `make demo` registers a generated structured pair. Cross builds: make CROSS_COMPILE=aarch64-linux-gnu-
+# `make golden` records the outputs the byte-for-byte test compares (tests/golden/) anew: only when
+# a change of the output is meant.
 CROSS_COMPILE ?=
 ifeq ($(origin CC),default)
 CC := $(CROSS_COMPILE)gcc
@@ -32,7 +34,7 @@ TEST_OBJ := $(patsubst %,$(BUILD)/obj/tests/%.o,test_main test_runner test_stage
 BINS := $(BUILD)/bin/home-register $(BUILD)/bin/home-make-pair $(BUILD)/bin/home-tests
 TEST_BINS := $(BUILD)/bin/home-tests
 
-.PHONY: all test demo install clean
+.PHONY: all test demo golden install clean
 all: $(LIB) $(BINS)
 
 -include $(sort $(wildcard mk/*.mk))
@@ -88,6 +90,9 @@ $(BUILD)/bin/home-tests: $(TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
 
 test: all
 	BUILD=$(BUILD) NM="$(NM)" OBJDUMP="$(OBJDUMP)" RUNNER="$(RUNNER)" CC="$(CC)" TEST_BINS="$(TEST_BINS)" SANFLAGS="$(if $(SANITIZE),-fsanitize=$(SANITIZE))" bash tests/run.sh
+
+golden: all
+	RUNNER="$(RUNNER)" bash tests/golden/golden.sh $(BUILD) --update
 
 # The stabilisation demo: a shaky clip of a structured, low-texture scene with known camera
 # motion, stabilised by home-stab (10 frames of lookahead); side-by-side Y4M (original |
