@@ -51,13 +51,13 @@ $(BUILD)/obj/src/%.o: src/%.c include/home.h include/home_limits.h src/home_inte
 # that -O2's cheapest vectoriser leaves scalar (0.4, 0.2 and 0.2 M instructions per video
 # frame). Element-wise IEEE operations in C99
 # mode (no contraction, no reassociation), so bit-identical output.
-# The line fit (src/homography.c) works on four matches per step in separate lanes, element-wise
+# The line fit (port/line_fit.h) works on four matches per step in separate lanes, element-wise
 # too; its sqrt vectorises only without errno (-fno-math-errno: same IEEE square roots).
 $(BUILD)/obj/src/hough.o $(BUILD)/obj/src/refine.o $(BUILD)/obj/src/describe.o $(BUILD)/obj/src/pipeline.o: CFLAGS_LIB += -ftree-vectorize
 # port/line_fit_avx2.c is the same fit compiled with AVX2 (four lanes, one 256-bit operation).
-$(BUILD)/obj/src/homography.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno
+$(BUILD)/obj/src/homography.o $(BUILD)/obj/port/line_fit_scalar.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno
 $(BUILD)/obj/port/line_fit_avx2.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno $(AVX2_FLAGS)
-$(BUILD)/obj/src/homography.o $(BUILD)/obj/port/line_fit_avx2.o: src/line_fit.h src/home_internal.h
+$(BUILD)/obj/port/line_fit_scalar.o $(BUILD)/obj/port/line_fit_avx2.o: port/line_fit.h port/line_fit_kernels.h
 $(BUILD)/obj/port/avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 $(BUILD)/obj/port/%.o: port/%.c include/home.h include/home_limits.h port/kernels.h
 	@mkdir -p $(dir $@)

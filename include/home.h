@@ -55,10 +55,10 @@ const char *home_strerror(int status);
 /* Optional timing hook: returns a monotonic time in milliseconds. The core has no OS clock. */
 typedef double (*home_clock_fn)(void *user);
 
-/* SIMD backend of a context. Every backend gives bit-identical results. home_default_config()
- * takes it from the environment variable HOME_SIMD=none|sse|avx2|neon when set (compile the
- * library with -DHOME_NO_GETENV for targets without an environment). AUTO picks NEON on ARM,
- * AVX2 on x86-64 CPUs that have it (SSE2 for everything but the Hough kernel), else SSE2. */
+/* SIMD backend of a context. Every backend gives bit-identical results. AUTO (the default)
+ * takes the environment variable HOME_SIMD=none|sse|avx2|neon when set (compile the library
+ * with -DHOME_NO_GETENV for targets without an environment), else picks NEON on ARM, AVX2 on
+ * x86-64 CPUs that have it (SSE2 for everything but the Hough kernel), else SSE2. */
 enum home_simd { HOME_SIMD_AUTO = 0, HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_NEON, HOME_SIMD_AVX2 };
 
 /* How J(theta, r) is computed. FAST: shear-and-add line sums of the image (one channel, exact

@@ -3,8 +3,6 @@
  * blur and keys (port/refine_avx2.c) and the stabiliser's warp (port/stab_avx2.c); the other
  * kernels of this table are the SSE2 ones. */
 #include "kernels.h"
-#include "refine_kernels.h"
-#include "stab_kernels.h"
 #if defined(HOME__HAVE_AVX2) && defined(__AVX2__)
 #include <immintrin.h>
 
@@ -225,10 +223,18 @@ static void box_down_avx2(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t 
     if (x < out_w) home__box_down_sse(src + ds * x, stride, ds, out + x, out_w - x);
 }
 
-const home__kernels home__kernels_avx2 = {"avx2", radon_blocks_avx2, home__nearest2_l1_sse,
-                                          smooth_row_avx2, smooth_cols_avx2, box_down_avx2,
-                                          extremum_candidates_avx2, line_ends_avx2, resample_avx2, &home__line_fit_avx2,
-    &home__refine_kernels_avx2, &home__stab_kernels_avx2};
+const home__kernels home__kernels_avx2 = {
+    .name = "avx2",
+    .radon_blocks = radon_blocks_avx2,
+    .nearest2_l1 = home__nearest2_l1_sse,
+    .smooth_row = smooth_row_avx2,
+    .smooth_cols = smooth_cols_avx2,
+    .box_down = box_down_avx2,
+    .extremum_candidates = extremum_candidates_avx2,
+    .line_ends = line_ends_avx2,
+    .resample = resample_avx2,
+    .line_fit = &home__line_fit_avx2,
+};
 #else
 typedef int home__avx2_unavailable; /* ISO C forbids an empty translation unit */
 #endif

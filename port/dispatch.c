@@ -1,55 +1,110 @@
-/* The one dispatch point: maps a home_simd request to a kernel table. Compiled with baseline
- * flags; the tables live in per-ISA files. No state: each context stores its own table. */
+/* The one SIMD resolver and the kernel tables it hands out. Compiled with baseline flags; the
+ * tables live in the per-ISA files. No state: a context stores the tables it was given. */
 #include "kernels.h"
 #include "refine_kernels.h"
 #include "stab_kernels.h"
 #include "home.h"
+#ifndef HOME_NO_GETENV
+#include <stdlib.h>
+#include <string.h>
+#endif
+
+/* 1 when the CPU runs this build's AVX2 kernels */
+static int have_avx2(void)
+{
+#ifdef HOME__HAVE_AVX2
+    return __builtin_cpu_supports("avx2") != 0;
+#else
+    return 0;
+#endif
+}
+
+/* the best backend this build and CPU have */
+static int best_simd(void)
+{
+#if defined(HOME__HAVE_NEON)
+    return HOME_SIMD_NEON;
+#elif defined(HOME__HAVE_SSE)
+    return have_avx2() ? HOME_SIMD_AVX2 : HOME_SIMD_SSE;
+#else
+    return HOME_SIMD_NONE;
+#endif
+}
+
+int home__simd_resolve(int simd)
+{
+#ifndef HOME_NO_GETENV
+    if (simd == HOME_SIMD_AUTO) {
+        const char *env = getenv("HOME_SIMD");
+        if (env && !strcmp(env, "none")) simd = HOME_SIMD_NONE;
+        else if (env && !strcmp(env, "sse")) simd = HOME_SIMD_SSE;
+        else if (env && !strcmp(env, "neon")) simd = HOME_SIMD_NEON;
+        else if (env && !strcmp(env, "avx2")) simd = HOME_SIMD_AVX2;
+    }
+#endif
+    switch (simd) {
+    case HOME_SIMD_AUTO: return best_simd();
+    case HOME_SIMD_NONE: return HOME_SIMD_NONE;
+#ifdef HOME__HAVE_SSE
+    case HOME_SIMD_SSE: return HOME_SIMD_SSE;
+#endif
+#ifdef HOME__HAVE_AVX2
+    case HOME_SIMD_AVX2: return have_avx2() ? HOME_SIMD_AVX2 : -1;
+#endif
+#ifdef HOME__HAVE_NEON
+    case HOME_SIMD_NEON: return HOME_SIMD_NEON;
+#endif
+    default: return -1;
+    }
+}
 
 const home__kernels *home__kernels_for(int simd)
 {
-    switch (simd) {
+    switch (home__simd_resolve(simd)) {
     case HOME_SIMD_NONE: return &home__kernels_scalar;
-    case HOME_SIMD_SSE:
 #ifdef HOME__HAVE_SSE
-        return &home__kernels_sse;
-#else
-        return NULL;
+    case HOME_SIMD_SSE: return &home__kernels_sse;
 #endif
-    case HOME_SIMD_AVX2:
 #ifdef HOME__HAVE_AVX2
-        return __builtin_cpu_supports("avx2") ? &home__kernels_avx2 : NULL;
-#else
-        return NULL;
+    case HOME_SIMD_AVX2: return &home__kernels_avx2;
 #endif
-    case HOME_SIMD_NEON:
 #ifdef HOME__HAVE_NEON
-        return &home__kernels_neon;
-#else
-        return NULL;
-#endif
-    case HOME_SIMD_AUTO:
-#if defined(HOME__HAVE_NEON)
-        return &home__kernels_neon;
-#elif defined(HOME__HAVE_AVX2)
-        return __builtin_cpu_supports("avx2") ? &home__kernels_avx2 : &home__kernels_sse;
-#elif defined(HOME__HAVE_SSE)
-        return &home__kernels_sse;
-#else
-        return &home__kernels_scalar;
+    case HOME_SIMD_NEON: return &home__kernels_neon;
 #endif
     default: return NULL;
     }
 }
 
-/* The refinement's and the stabiliser's tables follow the same choice. */
 const home__refine_kernels *home__refine_kernels_for(int simd)
 {
-    const home__kernels *k = home__kernels_for(simd);
-    return k ? k->refine : NULL;
+    switch (home__simd_resolve(simd)) {
+    case HOME_SIMD_NONE: return &home__refine_kernels_scalar;
+#ifdef HOME__HAVE_SSE
+    case HOME_SIMD_SSE: return &home__refine_kernels_sse;
+#endif
+#ifdef HOME__HAVE_AVX2
+    case HOME_SIMD_AVX2: return &home__refine_kernels_avx2;
+#endif
+#ifdef HOME__HAVE_NEON
+    case HOME_SIMD_NEON: return &home__refine_kernels_neon;
+#endif
+    default: return NULL;
+    }
 }
 
 const home__stab_kernels *home__stab_kernels_for(int simd)
 {
-    const home__kernels *k = home__kernels_for(simd);
-    return k ? k->stab : NULL;
+    switch (home__simd_resolve(simd)) {
+    case HOME_SIMD_NONE: return &home__stab_kernels_scalar;
+#ifdef HOME__HAVE_SSE
+    case HOME_SIMD_SSE: return &home__stab_kernels_sse;
+#endif
+#ifdef HOME__HAVE_AVX2
+    case HOME_SIMD_AVX2: return &home__stab_kernels_avx2;
+#endif
+#ifdef HOME__HAVE_NEON
+    case HOME_SIMD_NEON: return &home__stab_kernels_neon;
+#endif
+    default: return NULL;
+    }
 }

@@ -3,6 +3,7 @@
  * which tests/test_kernels.c checks on odd sizes, unaligned pointers and extreme inputs. */
 #ifndef HOME_KERNELS_H
 #define HOME_KERNELS_H
+#include "line_fit_kernels.h"
 #include <stddef.h>
 #include <stdint.h>
 
@@ -12,11 +13,6 @@
 #define HOME__MAX_TAPS_RADIUS 8
 /* Rows summed in 16-bit lanes before widening: 128 * 255 = 32640 fits int16. */
 #define HOME__RADON_ROWS_16BIT 128
-
-struct home__refine_kernels; /* port/refine_kernels.h */
-struct home__stab_kernels;   /* port/stab_kernels.h */
-struct home__line_fit;       /* src/home_internal.h */
-extern const struct home__line_fit home__line_fit_generic; /* src/homography.c */
 
 typedef struct home__kernels {
     const char *name;
@@ -60,11 +56,8 @@ typedef struct home__kernels {
                       float *line);
     /* Linear resampling: out[i] = line[k[i]] + f[i] * (line[k[i] + 1] - line[k[i]]), i < n. */
     void (*resample)(const float *line, const int16_t *k, const float *f, int n, float *out);
-    /* the homography's line fit (src/line_fit.h compiled for this instruction set) */
-    const struct home__line_fit *line_fit;
-    /* the photometric refinement's and the stabiliser's kernels of the same backend */
-    const struct home__refine_kernels *refine;
-    const struct home__stab_kernels *stab;
+    /* the homography's line fit (port/line_fit.h compiled for this instruction set) */
+    const home__line_fit *line_fit;
 } home__kernels;
 
 /* The references of line_ends and resample at one index (scalar kernels and SIMD tails). */
@@ -122,14 +115,18 @@ static inline int home__is_extremum(const float *up, const float *mid, const flo
 /* port/avx2.c is compiled with -mavx2 and used only when the CPU reports AVX2 */
 #define HOME__HAVE_AVX2 1
 extern const home__kernels home__kernels_avx2;
-extern const struct home__line_fit home__line_fit_avx2; /* port/line_fit_avx2.c */
 #endif
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #define HOME__HAVE_NEON 1
 extern const home__kernels home__kernels_neon;
 #endif
 
-/* The one dispatch point. The table for a home_simd value (HOME_SIMD_AUTO picks the best
- * compiled in), or NULL when that backend is not compiled into this build. */
+/* The one SIMD resolver (port/dispatch.c): the backend a home_simd request runs on. AUTO becomes
+ * the HOME_SIMD environment variable's choice when set (none, sse, avx2 or neon; not read when
+ * built with -DHOME_NO_GETENV), else the best this build and CPU have. Returns -1 when the
+ * request names a backend this build or CPU lacks. Every table lookup goes through it. */
+int home__simd_resolve(int simd);
+
+/* The table for a home_simd value, or NULL when home__simd_resolve() refuses it. */
 const home__kernels *home__kernels_for(int simd);
 #endif

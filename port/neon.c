@@ -1,7 +1,5 @@
 /* NEON kernels (aarch64, and armv7 built with -mfpu=neon). */
 #include "kernels.h"
-#include "refine_kernels.h"
-#include "stab_kernels.h"
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #include <arm_neon.h>
 
@@ -173,11 +171,18 @@ static int extremum_candidates_neon(const float *up, const float *mid, const flo
     return count;
 }
 
-const home__kernels home__kernels_neon = {"neon", radon_blocks_neon, nearest2_l1_neon,
-                                          smooth_row_neon, smooth_cols_neon, box_down_neon,
-                                          extremum_candidates_neon,
-                                          home__line_ends_scalar, home__resample_scalar, &home__line_fit_generic,
-    &home__refine_kernels_neon, &home__stab_kernels_neon};
+const home__kernels home__kernels_neon = {
+    .name = "neon",
+    .radon_blocks = radon_blocks_neon,
+    .nearest2_l1 = nearest2_l1_neon,
+    .smooth_row = smooth_row_neon,
+    .smooth_cols = smooth_cols_neon,
+    .box_down = box_down_neon,
+    .extremum_candidates = extremum_candidates_neon,
+    .line_ends = home__line_ends_scalar,
+    .resample = home__resample_scalar,
+    .line_fit = &home__line_fit_scalar,
+};
 #else
 typedef int home__neon_unavailable; /* ISO C forbids an empty translation unit */
 #endif

@@ -144,9 +144,16 @@ static void downsample_avx2(const uint8_t *src, ptrdiff_t src_stride, uint8_t *d
 }
 
 const home__refine_kernels home__refine_kernels_avx2 = {
-    "avx2", blur3_avx2, downsample_avx2, select_keys_avx2, home__refine_block_max_sse,
-    warp_avx2,
-    home__refine_accumulate_sse, home__refine_cauchy_sums_sse, home__refine_residuals_sse};
+    .name = "avx2",
+    .blur3 = blur3_avx2,
+    .downsample = downsample_avx2,
+    .select_keys = select_keys_avx2,
+    .block_max = home__refine_block_max_sse,
+    .warp = warp_avx2,
+    .accumulate = home__refine_accumulate_sse,
+    .cauchy_sums = home__refine_cauchy_sums_sse,
+    .residuals = home__refine_residuals_sse,
+};
 #else
 typedef int home__refine_avx2_unused; /* ISO C forbids an empty translation unit */
 #endif

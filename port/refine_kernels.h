@@ -137,6 +137,6 @@ extern const home__refine_kernels home__refine_kernels_avx2; /* port/refine_avx2
 extern const home__refine_kernels home__refine_kernels_neon;
 #endif
 
-/* The table for a home_simd value (AUTO: the best compiled in), NULL when not compiled in. */
+/* The table for a home_simd value (home__simd_resolve()), NULL when refused. */
 const home__refine_kernels *home__refine_kernels_for(int simd);
 #endif

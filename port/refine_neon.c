@@ -228,8 +228,16 @@ static void residuals_neon(const float *b, const int16_t *t, const float *wt, in
 }
 
 const home__refine_kernels home__refine_kernels_neon = {
-    "neon", blur3_neon, downsample_neon, select_keys_neon, block_max_neon, warp_neon, accumulate_neon,
-    cauchy_sums_neon, residuals_neon};
+    .name = "neon",
+    .blur3 = blur3_neon,
+    .downsample = downsample_neon,
+    .select_keys = select_keys_neon,
+    .block_max = block_max_neon,
+    .warp = warp_neon,
+    .accumulate = accumulate_neon,
+    .cauchy_sums = cauchy_sums_neon,
+    .residuals = residuals_neon,
+};
 #else
 typedef int home__refine_neon_unused; /* ISO C forbids an empty translation unit */
 #endif

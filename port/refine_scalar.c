@@ -120,6 +120,13 @@ static void residuals_scalar(const float *b, const int16_t *t, const float *wt, 
 }
 
 const home__refine_kernels home__refine_kernels_scalar = {
-    "none", blur3_scalar, downsample_scalar, select_keys_scalar, block_max_scalar, warp_scalar,
-    accumulate_scalar,
-    cauchy_sums_scalar, residuals_scalar};
+    .name = "none",
+    .blur3 = blur3_scalar,
+    .downsample = downsample_scalar,
+    .select_keys = select_keys_scalar,
+    .block_max = block_max_scalar,
+    .warp = warp_scalar,
+    .accumulate = accumulate_scalar,
+    .cauchy_sums = cauchy_sums_scalar,
+    .residuals = residuals_scalar,
+};

@@ -246,9 +246,16 @@ void home__refine_residuals_sse(const float *b, const int16_t *t, const float *w
 }
 
 const home__refine_kernels home__refine_kernels_sse = {
-    "sse", blur3_sse, home__refine_downsample_sse, select_keys_sse, home__refine_block_max_sse,
-    home__refine_warp_sse,
-    home__refine_accumulate_sse, home__refine_cauchy_sums_sse, home__refine_residuals_sse};
+    .name = "sse",
+    .blur3 = blur3_sse,
+    .downsample = home__refine_downsample_sse,
+    .select_keys = select_keys_sse,
+    .block_max = home__refine_block_max_sse,
+    .warp = home__refine_warp_sse,
+    .accumulate = home__refine_accumulate_sse,
+    .cauchy_sums = home__refine_cauchy_sums_sse,
+    .residuals = home__refine_residuals_sse,
+};
 #else
 typedef int home__refine_sse_unused; /* ISO C forbids an empty translation unit */
 #endif

@@ -1,7 +1,5 @@
 /* Scalar reference kernels: the definition every SIMD backend must reproduce bit for bit. */
 #include "kernels.h"
-#include "refine_kernels.h"
-#include "stab_kernels.h"
 #include <string.h>
 
 static void radon_blocks_scalar(const uint8_t *base, ptrdiff_t stride, const int16_t *shift,
@@ -92,8 +90,15 @@ void home__resample_scalar(const float *line, const int16_t *k, const float *f, 
     for (i = 0; i < n; i++) out[i] = home__resample_px(line, k[i], f[i]);
 }
 
-const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
-                                            smooth_row_scalar, smooth_cols_scalar, box_down_scalar,
-                                            extremum_candidates_scalar,
-                                            home__line_ends_scalar, home__resample_scalar, &home__line_fit_generic,
-    &home__refine_kernels_scalar, &home__stab_kernels_scalar};
+const home__kernels home__kernels_scalar = {
+    .name = "none",
+    .radon_blocks = radon_blocks_scalar,
+    .nearest2_l1 = nearest2_l1_scalar,
+    .smooth_row = smooth_row_scalar,
+    .smooth_cols = smooth_cols_scalar,
+    .box_down = box_down_scalar,
+    .extremum_candidates = extremum_candidates_scalar,
+    .line_ends = home__line_ends_scalar,
+    .resample = home__resample_scalar,
+    .line_fit = &home__line_fit_scalar,
+};

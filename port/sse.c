@@ -1,7 +1,5 @@
 /* SSE2 kernels (x86-64 baseline). */
 #include "kernels.h"
-#include "refine_kernels.h"
-#include "stab_kernels.h"
 #if defined(__SSE2__)
 #include <emmintrin.h>
 
@@ -182,11 +180,18 @@ int home__extremum_candidates_sse(const float *up, const float *mid, const float
     return count;
 }
 
-const home__kernels home__kernels_sse = {"sse", radon_blocks_sse, home__nearest2_l1_sse,
-                                         home__smooth_row_sse, home__smooth_cols_sse, home__box_down_sse,
-                                         home__extremum_candidates_sse,
-                                         home__line_ends_scalar, home__resample_scalar, &home__line_fit_generic,
-    &home__refine_kernels_sse, &home__stab_kernels_sse};
+const home__kernels home__kernels_sse = {
+    .name = "sse",
+    .radon_blocks = radon_blocks_sse,
+    .nearest2_l1 = home__nearest2_l1_sse,
+    .smooth_row = home__smooth_row_sse,
+    .smooth_cols = home__smooth_cols_sse,
+    .box_down = home__box_down_sse,
+    .extremum_candidates = home__extremum_candidates_sse,
+    .line_ends = home__line_ends_scalar,
+    .resample = home__resample_scalar,
+    .line_fit = &home__line_fit_scalar,
+};
 #else
 typedef int home__sse_unavailable; /* ISO C forbids an empty translation unit */
 #endif

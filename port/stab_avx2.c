@@ -5,7 +5,7 @@
  * control comes from the x fractions alone (pixel k's pair is at window offset
  * (k dx) >> 16 plus the carry of its fraction). The blend is pmaddubsw (horizontal, on pixels
  * offset by -128 so that the weight 128 fits a byte) and pmaddwd (vertical). Other groups gather
- * per pixel (port/stab_x86.h). Same bytes as the reference. */
+ * per pixel (port/stab_x86.h). Same bytes as the reference. Body only (home__stab_kernels). */
 #include "kernels.h"
 #include "stab_kernels.h"
 #if defined(HOME__HAVE_AVX2) && defined(__AVX2__)
@@ -61,8 +61,8 @@ __attribute__((noinline)) static void gather16(const uint8_t *src, ptrdiff_t str
             _mm256_inserti128_si256(_mm256_castsi128_si256(b0), b1, 1), frac_x, frac_y, dst);
 }
 
-static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
-                          int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
+static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0, int32_t y0,
+                          int32_t dx, int32_t dy, uint8_t *dst, int n)
 {
     const uint32_t dx8 = 8u * (uint32_t)dx, dx16 = 16u * (uint32_t)dx, dy15 = 15u * (uint32_t)dy, dy16 = 16u * (uint32_t)dy;
     /* the shuffle path: the pairs of a group of eight within 16 bytes (dx in [0, 2): pixel 7's
@@ -73,12 +73,8 @@ static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w,
     const __m256i lane = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     __m256i frac_x, frac_y, edge, pairs, step_x, step_y;
     const uint8_t *row;
-    uint8_t *d = dst, *const end = dst + (n & ~15), *fast_end;
+    uint8_t *d = dst, *const end = dst + n, *fast_end;
     uint32_t x = (uint32_t)x0, lo, yrel;   /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
-    if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
-        home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
-        return;
-    }
     {
         /* k dq & 0xffff = k (dq & 0xffff) & 0xffff: the fractions of pixels k = 0..15 are the
          * first's plus lanes k of these (wrapping like the Q16 sums) */
@@ -177,14 +173,9 @@ static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int step, int w,
             }
         }
     }
-    if (d < dst + n) {   /* the rest of an inside row: the reference's fast path, same bytes */
-        const uint32_t i = (uint32_t)(d - dst);
-        home__warp_row_c(src, stride, 1, w, h, (int32_t)x, (int32_t)((uint32_t)y0 + i * (uint32_t)dy), dx, dy, d, 1,
-                         n - (int)i);
-    }
 }
 
-const home__stab_kernels home__stab_kernels_avx2 = {"avx2", warp_row_avx2};
+const home__stab_kernels home__stab_kernels_avx2 = {.name = "avx2", .block = 16, .warp_row = warp_row_avx2};
 #else
 typedef int home__stab_avx2_unused; /* ISO C forbids an empty translation unit */
 #endif

@@ -4,8 +4,8 @@
  * indices come from the x fractions alone (pixel k's pair is at window offset (k dx) >> 16 plus
  * the carry of its fraction), as in port/stab_avx2.c; a group crossing a source row looks up
  * three row windows and selects per pixel. Other groups gather per pixel. The blend: widening
- * multiplies and rounding narrowing shifts that give the reference's bytes exactly. Rows that
- * need clamping, or are not planar, use the reference. */
+ * multiplies and rounding narrowing shifts that give the reference's bytes exactly. Body only
+ * (home__stab_kernels). */
 #include "stab_kernels.h"
 #include <string.h>
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
@@ -65,8 +65,8 @@ static void gather8(const uint8_t *src, ptrdiff_t stride, uint32_t x, uint32_t y
     blend8(vmovn_u16(top), vshrn_n_u16(top, 8), vmovn_u16(bot), vshrn_n_u16(bot, 8), frac_x, frac_y, dst);
 }
 
-static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
-                          int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
+static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0, int32_t y0,
+                          int32_t dx, int32_t dy, uint8_t *dst, int n)
 {
     const uint16x8_t step_x = vdupq_n_u16((uint16_t)(8u * (uint32_t)dx)), step_y = vdupq_n_u16((uint16_t)(8u * (uint32_t)dy));
     const uint32_t dx8 = 8u * (uint32_t)dx, dy7 = 7u * (uint32_t)dy, dy8 = 8u * (uint32_t)dy;
@@ -80,12 +80,8 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w,
     uint16x8_t frac_x, frac_y, edge;
     uint8x8_t k0, k1;
     const uint8_t *row;
-    uint8_t *d = dst, *const end = dst + (n & ~7), *fast_end;
+    uint8_t *d = dst, *const end = dst + n, *fast_end;
     uint32_t x = (uint32_t)x0, lo, yrel;   /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
-    if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
-        home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
-        return;
-    }
     {
         /* pixel k of a group (first pixel's fraction f) has its pair at window offset D_k + carry,
          * D_k = (k dx) >> 16, carry = f + (k dx & 0xffff) >= 2^16: its own fraction below
@@ -166,14 +162,9 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int step, int w,
             }
         }
     }
-    if (d < dst + n) {   /* the rest of an inside row: the reference's fast path, same bytes */
-        const uint32_t i = (uint32_t)(d - dst);
-        home__warp_row_c(src, stride, 1, w, h, (int32_t)x, (int32_t)((uint32_t)y0 + i * (uint32_t)dy), dx, dy, d, 1,
-                         n - (int)i);
-    }
 }
 
-const home__stab_kernels home__stab_kernels_neon = {"neon", warp_row_neon};
+const home__stab_kernels home__stab_kernels_neon = {.name = "neon", .block = 8, .warp_row = warp_row_neon};
 #else
 typedef int home__stab_neon_unused; /* ISO C forbids an empty translation unit */
 #endif

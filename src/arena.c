@@ -1,7 +1,6 @@
 /* Configuration, arena layout and context initialisation. */
 #include "home_internal.h"
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 const char *home_strerror(int status)
@@ -76,15 +75,6 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->match_theta_window = 0;
     cfg->max_model = HOME_MODEL_HOMOGRAPHY;
     cfg->max_sigma_px = 1.0f;
-#ifndef HOME_NO_GETENV
-    {
-        const char *env = getenv("HOME_SIMD");
-        if (env && !strcmp(env, "none")) cfg->simd = HOME_SIMD_NONE;
-        else if (env && !strcmp(env, "sse")) cfg->simd = HOME_SIMD_SSE;
-        else if (env && !strcmp(env, "neon")) cfg->simd = HOME_SIMD_NEON;
-        else if (env && !strcmp(env, "avx2")) cfg->simd = HOME_SIMD_AVX2;
-    }
-#endif
     if (width < HOME_MIN_SIDE || height < HOME_MIN_SIDE || width > HOME_MAX_SIDE ||
         height > HOME_MAX_SIDE)
         return HOME_E_SIZE;

@@ -4,6 +4,7 @@
 
 #include "home.h"
 #include "kernels.h"
+#include "line_fit_kernels.h"
 #include "refine_kernels.h"
 
 #define HOME__MAGIC_CTX 0x484f4d43u   /* "HOMC" */
@@ -39,12 +40,6 @@ typedef struct home__extremum {
     float theta_bin, r_bin, saliency;
     int sign;
 } home__extremum;
-
-/* A candidate match: line (theta_a, r_a) in A against (theta_b, r_b) in B. */
-typedef struct home__match {
-    float theta_a, r_a, theta_b, r_b;
-    double cos_a, sin_a, cos_b, sin_b; /* precomputed for the homography fit */
-} home__match;
 
 /* refine.c: template points of one pyramid level, structure of arrays padded to 4 lanes */
 typedef struct home__refine_points {
@@ -191,31 +186,14 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
 int home__homography_plausible(const double *h, int width, int height);
 
 /* lm.c: minimise a sum of squares over 8 parameters. The problem supplies its cost and, when
- * jtj is not NULL, the Gauss-Newton normal equations J^T J (8x8, row-major) and J^T e at p, so
- * it can exploit the structure of its Jacobian. */
-typedef double (*home__normal_fn)(const void *user, const double *p, double *jtj, double *jte);
+ * jtj is not NULL, the Gauss-Newton normal equations (home__normal_fn, port/line_fit_kernels.h),
+ * so it can exploit the structure of its Jacobian. */
 int home__lm_solve(double *p, home__normal_fn fn, const void *user, int max_iters);
 int home__solve_spd8(double *a, double *b);
 /* The same in two steps, to solve for several right-hand sides with one factor. */
 int home__cholesky8(double *a);
 void home__cholesky_solve8(const double *l, double *b);
 
-/* line_fit.h: the homography's line fit over matched lines, one implementation compiled per
- * instruction set (the backend's table picks it); the same bits from each. */
-typedef struct home__line_problem {
-    const home__match *matches;
-    const int *index;        /* the inliers the fit runs over */
-    int n;
-    double scale, inv_scale; /* half diagonal, px: normalises r */
-    double w_theta, w_r;     /* residual weights into Hough bins */
-} home__line_problem;
-typedef struct home__line_fit {
-    /* cost, and J^T J, J^T e when jtj is not NULL, over the inliers (home__lm_solve's fn) */
-    home__normal_fn normal;
-    /* the matches (of n) whose transfer error at g is under threshold, into index; how many */
-    int (*select_inliers)(const home__line_problem *lp, int n, const double *g, double threshold,
-                          int *index);
-} home__line_fit;
 
 /* model.c: motion-model selection over a fit's Fisher information (see there) */
 #define HOME__SPACE_H 0          /* parameters: the homography's entries h0..h7 */

@@ -3,7 +3,7 @@
  * crop-window constraint, hold-on-failure. See include/home_stab.h for the contract. */
 #include "home_stab.h"
 #include "kernels.h"
-#include "stab_kernels.h"
+#include "stab_internal.h"
 #include <math.h>
 #include <string.h>
 

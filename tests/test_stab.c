@@ -5,7 +5,7 @@
 #ifdef HOME_STAB_TESTS
 #include "home_stab.h"
 #include "stab_clip.h"
-#include "stab_kernels.h"
+#include "stab_internal.h"
 #include "synth.h"
 #include "test.h"
 #include <math.h>
@@ -638,8 +638,8 @@ static void test_warp_backends_identical(void)
             memset(out, 0x77, sizeof out);
             home__warp_row_c(plane, stride, step, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536),
                              dx, dy, ref + dofs, dst_step, n);
-            kern->warp_row(plane, stride, step, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536), dx,
-                           dy, out + dofs, dst_step, n);
+            home__warp_row(kern, plane, stride, step, w, h, (int32_t)(x0 * 65536),
+                           (int32_t)(y0 * 65536), dx, dy, out + dofs, dst_step, n);
             mismatches += memcmp(ref, out, sizeof ref) != 0;
         }
         printf("    warp backend %s: %d mismatching rows of 4500 (%d stabilisation-like rows of 32+ pixels "
@@ -674,7 +674,8 @@ static void test_warp_plane_end(void)
                 memset(ref, 0x77, sizeof ref);
                 memset(out, 0x77, sizeof out);
                 home__warp_row_c(plane, w, 1, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536), dx, 0, ref + 1, 1, n);
-                kern->warp_row(plane, w, 1, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536), dx, 0, out + 1, 1, n);
+                home__warp_row(kern, plane, w, 1, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536), dx,
+                               0, out + 1, 1, n);
                 mismatches += memcmp(ref, out, sizeof ref) != 0;
                 rows++;
             }
