@@ -141,7 +141,8 @@ int home_validate_config(const home_config *cfg);
 typedef struct home_context home_context;
 
 /* Name of the SIMD backend a context uses ("none", "sse", "avx2", "neon"); with ctx == NULL, the
- * backend HOME_SIMD_AUTO would pick in this build. */
+ * backend HOME_SIMD_AUTO would pick here ("unavailable" when HOME_SIMD names one this build or
+ * CPU lacks). */
 const char *home_simd_backend(const home_context *ctx);
 
 /* Exact bytes home_init() needs for cfg; 0 when cfg is invalid. */

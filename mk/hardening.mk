@@ -48,7 +48,7 @@ fuzz-build:
 # The pixel loops (Hough transform, smoothing, gradients, extrema, descriptors, refinement and
 # warp kernels) keep edge coverage and the sanitizers but not comparison tracing: trace-cmp's call
 # on every loop test was 70% of an execution and only fed loop bounds and pixel values to the
-# mutator. Validation and decisions (arena.c, match.c, homography.c, stabilise.c) keep it;
+# mutator. Validation and decisions (config.c, context.c, match.c, homography.c, stabilise.c) keep it;
 # pipeline.c (the per-row detection callback) and lm.c (the solver's loops) were a further 10%.
 FUZZ_NO_TRACE_CMP := $(wildcard port/*.c) src/hough.c src/smooth.c src/gradient.c src/extrema.c \
 	src/describe.c src/refine.c src/warp.c src/pipeline.c src/lm.c

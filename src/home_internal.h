@@ -4,6 +4,7 @@
 
 #include "home.h"
 #include "kernels.h"
+#include <math.h>
 #include "line_fit_kernels.h"
 #include "refine_kernels.h"
 
@@ -123,10 +124,32 @@ struct home_context {
     home__refine_state refine;
 };
 
-/* arena.c */
+/* Arena blocks start on this boundary (cache line, widest SIMD load). */
+#define HOME__BLOCK_ALIGN 64u
+
+/* n rounded up to a multiple of a (a power of two) */
+static inline size_t home__align_up(size_t n, size_t a) { return (n + a - 1) & ~(a - 1); }
+
+/* The offset of the next block of bytes at *cursor (HOME__BLOCK_ALIGN), and the cursor past it. */
+static inline size_t home__take(size_t *cursor, size_t bytes)
+{
+    const size_t at = home__align_up(*cursor, HOME__BLOCK_ALIGN);
+    *cursor = at + bytes;
+    return at;
+}
+
+/* 1 when v is finite and in [lo, hi] */
+static inline int home__finite_in(double v, double lo, double hi)
+{
+    return isfinite(v) && v >= lo && v <= hi;
+}
+
+/* config.c */
 uint32_t home__config_id(const home_config *cfg);
 int home__r_bins(const home_config *cfg);
 void home__hough_size(const home_config *cfg, int *width, int *height);
+
+/* common.c: the image check and the clock every stage uses */
 int home__check_image(const home_context *ctx, const uint8_t *image, ptrdiff_t stride);
 double home__now(const home_context *ctx);
 
@@ -148,6 +171,10 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
 void home__hough_raw_rows(const home_config *cfg, int radius, int *first, int *count);
 /* Fill a geometry record (its arrays already carved) for theta. */
 void home__theta_geometry(const home_context *ctx, double theta, home__theta_geom *g);
+/* The Hough stage's arena block: its bytes, and its buffers and geometry laid out in it (the
+ * context's sizes, cfg and r_bins, already set). */
+size_t home__hough_bytes(const home_config *cfg);
+void home__hough_init(home_context *ctx, unsigned char *block);
 double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t stride,
                           home__row_fn on_row, void *user);
 

@@ -22,7 +22,8 @@ def symbols(obj, undefined):
     return {line.split()[-1] for line in out.splitlines() if line.strip()}
 
 
-objs = sorted(glob.glob(os.path.join(build, "obj/src/*.o")) + glob.glob(os.path.join(build, "obj/port/*.o")))
+objs = [os.path.join(build, "obj", c[:-2] + ".o") for c in sorted(glob.glob("src/*.c") + glob.glob("port/*.c"))]
+objs = [o for o in objs if os.path.exists(o)]
 if not objs:
     sys.exit("layers: no objects under %s/obj" % build)
 name = {o: os.path.relpath(o, os.path.join(build, "obj")) for o in objs}
