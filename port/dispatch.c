@@ -9,23 +9,20 @@
 #include <string.h>
 #endif
 
-/* 1 when the CPU runs this build's AVX2 kernels */
-static int have_avx2(void)
-{
 #ifdef HOME__HAVE_AVX2
-    return __builtin_cpu_supports("avx2") != 0;
-#else
-    return 0;
+/* 1 when the CPU runs this build's AVX2 kernels */
+static int have_avx2(void) { return __builtin_cpu_supports("avx2") != 0; }
 #endif
-}
 
 /* the best backend this build and CPU have */
 static int best_simd(void)
 {
 #if defined(HOME__HAVE_NEON)
     return HOME_SIMD_NEON;
-#elif defined(HOME__HAVE_SSE)
+#elif defined(HOME__HAVE_AVX2)
     return have_avx2() ? HOME_SIMD_AVX2 : HOME_SIMD_SSE;
+#elif defined(HOME__HAVE_SSE)
+    return HOME_SIMD_SSE;
 #else
     return HOME_SIMD_NONE;
 #endif
