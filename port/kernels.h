@@ -112,7 +112,7 @@ static inline int home__is_extremum(const float *up, const float *mid, const flo
     return 0;
 }
 #if defined(__x86_64__) && !defined(HOME_NO_AVX2)
-/* port/avx2.c is compiled with -mavx2 and used only when the CPU reports AVX2 */
+/* the port/..._avx2.c files are compiled with -mavx2 and used only when the CPU reports AVX2 */
 #define HOME__HAVE_AVX2 1
 extern const home__kernels home__kernels_avx2;
 #endif
