@@ -43,13 +43,13 @@ static void radon_blocks_avx2(const uint8_t *base, ptrdiff_t stride, const int16
 }
 
 /* Same multiply-then-add order as the scalar reference (no FMA), 8 outputs at a time:
- * bit-identical; the tails go to the SSE2 kernels. */
+ * bit-identical. Body only: the callers finish the tails. */
 /* The taps in the reference's order (k = 0 .. 2 radius), one product and one sum each. With the
  * default radius 4 (sigma 1.3) the nine broadcast taps stay in registers, unrolled; other radii
  * take the generic loop. */
 #define SMOOTH_TAP(k, src) acc = _mm256_add_ps(acc, _mm256_mul_ps(t##k, _mm256_loadu_ps(src)))
 
-static void smooth_row_avx2(const float *in, float *out, int n, const float *taps, int radius)
+static int smooth_row_avx2(const float *in, float *out, int n, const float *taps, int radius)
 {
     int i = radius, k;
     if (radius == 4) {
@@ -71,11 +71,11 @@ static void smooth_row_avx2(const float *in, float *out, int n, const float *tap
             acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(in + i - radius + k)));
         _mm256_storeu_ps(out + i, acc);
     }
-    home__smooth_row_sse(in + i - radius, out + i - radius, n - i + radius, taps, radius);
+    return i;
 }
 
-static void smooth_cols_avx2(const float *const *rows, float *out, int n, const float *taps,
-                             int radius)
+static int smooth_cols_avx2(const float *const *rows, float *out, int n, const float *taps,
+                            int radius)
 {
     int i = 0, k;
     if (radius == 4) {
@@ -98,17 +98,13 @@ static void smooth_cols_avx2(const float *const *rows, float *out, int n, const 
             acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(rows[k] + i)));
         _mm256_storeu_ps(out + i, acc);
     }
-    if (i < n) {
-        const float *tail[2 * HOME__MAX_TAPS_RADIUS + 1];
-        for (k = 0; k <= 2 * radius; k++) tail[k] = rows[k] + i;
-        home__smooth_cols_sse(tail, out + i, n - i, taps, radius);
-    }
+    return i;
 }
 #undef SMOOTH_TAP
 
 /* The SSE2 kernel's test on eight bins per step. */
 static int extremum_candidates_avx2(const float *up, const float *mid, const float *down, int n,
-                                    int *idx)
+                                    int *idx, int *end)
 {
     const __m256 zero = _mm256_setzero_ps();
     int i, count = 0;
@@ -127,8 +123,7 @@ static int extremum_candidates_avx2(const float *up, const float *mid, const flo
         for (lane = 0; mask; lane++, mask >>= 1)
             if (mask & 1) idx[count++] = i + lane;
     }
-    for (; i < n - 1; i++)
-        if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
+    *end = i;
     return count;
 }
 

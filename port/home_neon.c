@@ -1,6 +1,7 @@
 /* NEON kernels (aarch64, and armv7 built with -mfpu=neon). */
 #include "kernels.h"
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
+#include "home_f32x4.h"
 #include <arm_neon.h>
 
 /* 64 lanes held as 8 x 8 uint16 in registers (vaddw_u8 widens while adding); widened into
@@ -50,73 +51,6 @@ static void nearest2_l1_neon(const uint8_t *query, const uint8_t *cands, ptrdiff
     *best = b; *d1 = m1; *d2 = m2;
 }
 
-/* vmulq then vaddq (never a fused multiply-add): the same rounding as the scalar reference. */
-/* The taps in the reference's order, one product and one sum each (no fused multiply-add); the
- * default radius 4 (sigma 1.3) unrolled with its nine taps in registers, other radii by the
- * generic loop. */
-#define SMOOTH_TAP(k, src) acc = vaddq_f32(acc, vmulq_f32(t##k, vld1q_f32(src)))
-#define SMOOTH_TAPS_4 \
-    const float32x4_t t0 = vdupq_n_f32(taps[0]), t1 = vdupq_n_f32(taps[1]), t2 = vdupq_n_f32(taps[2]), \
-                      t3 = vdupq_n_f32(taps[3]), t4 = vdupq_n_f32(taps[4]), t5 = vdupq_n_f32(taps[5]), \
-                      t6 = vdupq_n_f32(taps[6]), t7 = vdupq_n_f32(taps[7]), t8 = vdupq_n_f32(taps[8])
-
-static void smooth_row_neon(const float *in, float *out, int n, const float *taps, int radius)
-{
-    int i = radius, k;
-    if (radius == 4) {
-        SMOOTH_TAPS_4;
-        for (; i + 4 <= n - radius; i += 4) {
-            const float *p = in + i - 4;
-            float32x4_t acc = vdupq_n_f32(0.0f);
-            SMOOTH_TAP(0, p); SMOOTH_TAP(1, p + 1); SMOOTH_TAP(2, p + 2); SMOOTH_TAP(3, p + 3);
-            SMOOTH_TAP(4, p + 4); SMOOTH_TAP(5, p + 5); SMOOTH_TAP(6, p + 6); SMOOTH_TAP(7, p + 7);
-            SMOOTH_TAP(8, p + 8);
-            vst1q_f32(out + i, acc);
-        }
-    }
-    for (; i + 4 <= n - radius; i += 4) {
-        float32x4_t acc = vdupq_n_f32(0.0f);
-        for (k = 0; k <= 2 * radius; k++)
-            acc = vaddq_f32(acc, vmulq_f32(vdupq_n_f32(taps[k]), vld1q_f32(in + i - radius + k)));
-        vst1q_f32(out + i, acc);
-    }
-    /* the last < 4 outputs by the reference, on a window that starts at output i */
-    home__kernels_scalar.smooth_row(in + i - radius, out + i - radius, n - i + radius, taps, radius);
-}
-
-static void smooth_cols_neon(const float *const *rows, float *out, int n, const float *taps,
-                             int radius)
-{
-    int i = 0, k;
-    if (radius == 4) {
-        SMOOTH_TAPS_4;
-        const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4],
-                    *r5 = rows[5], *r6 = rows[6], *r7 = rows[7], *r8 = rows[8];
-        for (; i + 4 <= n; i += 4) {
-            float32x4_t acc = vdupq_n_f32(0.0f);
-            SMOOTH_TAP(0, r0 + i); SMOOTH_TAP(1, r1 + i); SMOOTH_TAP(2, r2 + i); SMOOTH_TAP(3, r3 + i);
-            SMOOTH_TAP(4, r4 + i); SMOOTH_TAP(5, r5 + i); SMOOTH_TAP(6, r6 + i); SMOOTH_TAP(7, r7 + i);
-            SMOOTH_TAP(8, r8 + i);
-            vst1q_f32(out + i, acc);
-        }
-    }
-    for (; i + 4 <= n; i += 4) {
-        float32x4_t acc = vdupq_n_f32(0.0f);
-        for (k = 0; k <= 2 * radius; k++)
-            acc = vaddq_f32(acc, vmulq_f32(vdupq_n_f32(taps[k]), vld1q_f32(rows[k] + i)));
-        vst1q_f32(out + i, acc);
-    }
-    if (i < n) {
-        const float *tail[2 * HOME__MAX_TAPS_RADIUS + 1];
-        for (k = 0; k <= 2 * radius; k++) tail[k] = rows[k] + i;
-        home__kernels_scalar.smooth_cols(tail, out + i, n - i, taps, radius);
-    }
-}
-#undef SMOOTH_TAP
-#undef SMOOTH_TAPS_4
-
-/* 8 outputs per step: pairwise widening adds along the row, accumulated over the rows, then a
- * rounding narrowing shift ((sum + half) >> shift); the tail by the reference. */
 static void box_down_neon(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
 {
     int x = 0, v;
@@ -141,44 +75,14 @@ static void box_down_neon(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t 
     if (x < out_w) home__kernels_scalar.box_down(src + ds * x, stride, ds, out + x, out_w - x);
 }
 
-/* Four bins per step as in the SSE2 kernel; "any lane set" by a pairwise max (armv7 has no
- * across-vector reduction). */
-static int extremum_candidates_neon(const float *up, const float *mid, const float *down, int n,
-                                    int *idx)
-{
-    const float32x4_t zero = vdupq_n_f32(0.0f);
-    int i, count = 0, lane;
-    for (i = 1; i + 4 <= n - 1; i += 4) {
-        float32x4_t v = vld1q_f32(mid + i);
-        float32x4_t a = vld1q_f32(up + i - 1), b = vld1q_f32(up + i), c = vld1q_f32(up + i + 1);
-        float32x4_t d = vld1q_f32(mid + i - 1), e = vld1q_f32(mid + i + 1);
-        float32x4_t f = vld1q_f32(down + i - 1), g = vld1q_f32(down + i), h = vld1q_f32(down + i + 1);
-        float32x4_t hi = vmaxq_f32(vmaxq_f32(vmaxq_f32(a, b), vmaxq_f32(c, d)),
-                                   vmaxq_f32(vmaxq_f32(e, f), vmaxq_f32(g, h)));
-        float32x4_t lo = vminq_f32(vminq_f32(vminq_f32(a, b), vminq_f32(c, d)),
-                                   vminq_f32(vminq_f32(e, f), vminq_f32(g, h)));
-        uint32x4_t m = vorrq_u32(vandq_u32(vcgtq_f32(v, zero), vcgtq_f32(v, hi)),
-                                 vandq_u32(vcltq_f32(v, zero), vcltq_f32(v, lo)));
-        uint32x2_t any = vorr_u32(vget_low_u32(m), vget_high_u32(m));
-        uint32_t bits[4];
-        if (!vget_lane_u32(vpmax_u32(any, any), 0)) continue;
-        vst1q_u32(bits, m);
-        for (lane = 0; lane < 4; lane++)
-            if (bits[lane]) idx[count++] = i + lane;
-    }
-    for (; i < n - 1; i++)
-        if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
-    return count;
-}
-
 const home__kernels home__kernels_neon = {
     .name = "neon",
     .radon_blocks = radon_blocks_neon,
     .nearest2_l1 = nearest2_l1_neon,
-    .smooth_row = smooth_row_neon,
-    .smooth_cols = smooth_cols_neon,
+    .smooth_row = smooth_row_f4,
+    .smooth_cols = smooth_cols_f4,
     .box_down = box_down_neon,
-    .extremum_candidates = extremum_candidates_neon,
+    .extremum_candidates = extremum_candidates_f4,
     .line_ends = home__line_ends_scalar,
     .resample = home__resample_scalar,
     .line_fit = &home__line_fit_scalar,

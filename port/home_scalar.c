@@ -31,25 +31,17 @@ static void nearest2_l1_scalar(const uint8_t *query, const uint8_t *cands, ptrdi
     *best = b; *d1 = m1; *d2 = m2;
 }
 
-static void smooth_row_scalar(const float *in, float *out, int n, const float *taps, int radius)
+static int smooth_row_scalar(const float *in, float *out, int n, const float *taps, int radius)
 {
-    int i, k;
-    for (i = radius; i < n - radius; i++) {
-        float acc = 0.0f;
-        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * in[i - radius + k];
-        out[i] = acc;
-    }
+    home__smooth_row_px(in, out, radius, n - radius, taps, radius);
+    return n - radius;
 }
 
-static void smooth_cols_scalar(const float *const *rows, float *out, int n, const float *taps,
-                               int radius)
+static int smooth_cols_scalar(const float *const *rows, float *out, int n, const float *taps,
+                              int radius)
 {
-    int i, k;
-    for (i = 0; i < n; i++) {
-        float acc = 0.0f;
-        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * rows[k][i];
-        out[i] = acc;
-    }
+    home__smooth_cols_px(rows, out, 0, n, taps, radius);
+    return n;
 }
 
 static void box_down_scalar(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
@@ -65,11 +57,12 @@ static void box_down_scalar(const uint8_t *src, ptrdiff_t stride, int ds, uint8_
 }
 
 static int extremum_candidates_scalar(const float *up, const float *mid, const float *down, int n,
-                                      int *idx)
+                                      int *idx, int *end)
 {
     int i, count = 0;
     for (i = 1; i < n - 1; i++)
         if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
+    *end = i;
     return count;
 }
 

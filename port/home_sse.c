@@ -1,6 +1,7 @@
 /* SSE2 kernels (x86-64 baseline). */
 #include "kernels.h"
 #if defined(__SSE2__)
+#include "home_f32x4.h"
 #include <emmintrin.h>
 
 /* 64 lanes held as 8 x 8 uint16 in registers; widened into int32 every 128 rows. */
@@ -51,70 +52,6 @@ void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t
     *best = b; *d1 = m1; *d2 = m2;
 }
 
-/* Same multiply-then-add order as the scalar reference, 4 outputs at a time: bit-identical. */
-/* The taps in the reference's order, one product and one sum each; the default radius 4 (sigma
- * 1.3) unrolled with its nine broadcast taps in registers, other radii by the generic loop. */
-#define SMOOTH_TAP(k, src) acc = _mm_add_ps(acc, _mm_mul_ps(t##k, _mm_loadu_ps(src)))
-#define SMOOTH_TAPS_4 \
-    const __m128 t0 = _mm_set1_ps(taps[0]), t1 = _mm_set1_ps(taps[1]), t2 = _mm_set1_ps(taps[2]), \
-                 t3 = _mm_set1_ps(taps[3]), t4 = _mm_set1_ps(taps[4]), t5 = _mm_set1_ps(taps[5]), \
-                 t6 = _mm_set1_ps(taps[6]), t7 = _mm_set1_ps(taps[7]), t8 = _mm_set1_ps(taps[8])
-
-void home__smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius)
-{
-    int i = radius, k;
-    if (radius == 4) {
-        SMOOTH_TAPS_4;
-        for (; i + 4 <= n - radius; i += 4) {
-            const float *p = in + i - 4;
-            __m128 acc = _mm_setzero_ps();
-            SMOOTH_TAP(0, p); SMOOTH_TAP(1, p + 1); SMOOTH_TAP(2, p + 2); SMOOTH_TAP(3, p + 3);
-            SMOOTH_TAP(4, p + 4); SMOOTH_TAP(5, p + 5); SMOOTH_TAP(6, p + 6); SMOOTH_TAP(7, p + 7);
-            SMOOTH_TAP(8, p + 8);
-            _mm_storeu_ps(out + i, acc);
-        }
-    }
-    for (; i + 4 <= n - radius; i += 4) {
-        __m128 acc = _mm_setzero_ps();
-        for (k = 0; k <= 2 * radius; k++)
-            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(taps[k]), _mm_loadu_ps(in + i - radius + k)));
-        _mm_storeu_ps(out + i, acc);
-    }
-    /* the last < 4 outputs by the reference, on a window that starts at output i */
-    home__kernels_scalar.smooth_row(in + i - radius, out + i - radius, n - i + radius, taps, radius);
-}
-
-void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
-                           int radius)
-{
-    int i = 0, k;
-    if (radius == 4) {
-        SMOOTH_TAPS_4;
-        const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4],
-                    *r5 = rows[5], *r6 = rows[6], *r7 = rows[7], *r8 = rows[8];
-        for (; i + 4 <= n; i += 4) {
-            __m128 acc = _mm_setzero_ps();
-            SMOOTH_TAP(0, r0 + i); SMOOTH_TAP(1, r1 + i); SMOOTH_TAP(2, r2 + i); SMOOTH_TAP(3, r3 + i);
-            SMOOTH_TAP(4, r4 + i); SMOOTH_TAP(5, r5 + i); SMOOTH_TAP(6, r6 + i); SMOOTH_TAP(7, r7 + i);
-            SMOOTH_TAP(8, r8 + i);
-            _mm_storeu_ps(out + i, acc);
-        }
-    }
-    for (; i + 4 <= n; i += 4) {
-        __m128 acc = _mm_setzero_ps();
-        for (k = 0; k <= 2 * radius; k++)
-            acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(taps[k]), _mm_loadu_ps(rows[k] + i)));
-        _mm_storeu_ps(out + i, acc);
-    }
-    if (i < n) {
-        const float *tail[2 * HOME__MAX_TAPS_RADIUS + 1];
-        for (k = 0; k <= 2 * radius; k++) tail[k] = rows[k] + i;
-        home__kernels_scalar.smooth_cols(tail, out + i, n - i, taps, radius);
-    }
-}
-#undef SMOOTH_TAP
-#undef SMOOTH_TAPS_4
-
 /* 16 outputs per step: rows summed in 16-bit lanes, neighbours paired by pmaddwd with ones (twice
  * for ds = 4), rounded and packed back to bytes; the tail by the reference. */
 void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
@@ -151,43 +88,14 @@ void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *o
     if (x < out_w) home__kernels_scalar.box_down(src + ds * x, stride, ds, out + x, out_w - x);
 }
 
-/* Four bins per step: the largest and smallest of the eight neighbours, then the sign test;
- * most steps have no candidate and cost one movemask. */
-int home__extremum_candidates_sse(const float *up, const float *mid, const float *down, int n,
-                                  int *idx)
-{
-    const __m128 zero = _mm_setzero_ps();
-    int i, count = 0;
-    for (i = 1; i + 4 <= n - 1; i += 4) {
-        __m128 v = _mm_loadu_ps(mid + i);
-        __m128 a = _mm_loadu_ps(up + i - 1), b = _mm_loadu_ps(up + i), c = _mm_loadu_ps(up + i + 1);
-        __m128 d = _mm_loadu_ps(mid + i - 1), e = _mm_loadu_ps(mid + i + 1);
-        __m128 f = _mm_loadu_ps(down + i - 1), g = _mm_loadu_ps(down + i), h = _mm_loadu_ps(down + i + 1);
-        __m128 hi = _mm_max_ps(_mm_max_ps(_mm_max_ps(a, b), _mm_max_ps(c, d)),
-                               _mm_max_ps(_mm_max_ps(e, f), _mm_max_ps(g, h)));
-        __m128 lo = _mm_min_ps(_mm_min_ps(_mm_min_ps(a, b), _mm_min_ps(c, d)),
-                               _mm_min_ps(_mm_min_ps(e, f), _mm_min_ps(g, h)));
-        int mask = _mm_movemask_ps(_mm_or_ps(_mm_and_ps(_mm_cmpgt_ps(v, zero), _mm_cmpgt_ps(v, hi)),
-                                             _mm_and_ps(_mm_cmplt_ps(v, zero), _mm_cmplt_ps(v, lo))));
-        while (mask) {
-            int lane = mask & 1 ? 0 : mask & 2 ? 1 : mask & 4 ? 2 : 3;
-            idx[count++] = i + lane;
-            mask &= mask - 1;
-        }
-    }
-    for (; i < n - 1; i++)
-        if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
-    return count;
-}
-
 const home__kernels home__kernels_sse = {
     .name = "sse",
     .radon_blocks = radon_blocks_sse,
     .nearest2_l1 = home__nearest2_l1_sse,
-    .smooth_row = home__smooth_row_sse,
-    .smooth_cols = home__smooth_cols_sse,
+    .smooth_row = smooth_row_f4,
+    .smooth_cols = smooth_cols_f4,
     .box_down = home__box_down_sse,
-    .extremum_candidates = home__extremum_candidates_sse,
+    .extremum_candidates = extremum_candidates_f4,
     .line_ends = home__line_ends_scalar,
     .resample = home__resample_scalar,
     .line_fit = &home__line_fit_scalar,

@@ -29,21 +29,24 @@ typedef struct home__kernels {
      * (1 << 30 when absent). */
     void (*nearest2_l1)(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
                         int *best, int *d1, int *d2);
-    /* out[i] = sum_k taps[k] * in[i - radius + k] (k = 0 .. 2 radius, in this order), for i in
-     * [radius, n - radius): the interior of a row; callers handle the borders. */
-    void (*smooth_row)(const float *in, float *out, int n, const float *taps, int radius);
-    /* out[i] = sum_k taps[k] * rows[k][i] (k = 0 .. 2 radius, in this order), i in [0, n). */
-    void (*smooth_cols)(const float *const *rows, float *out, int n, const float *taps,
-                        int radius);
+    /* out[i] = sum_k taps[k] * in[i - radius + k] (k = 0 .. 2 radius, in this order) for i in
+     * [radius, e), the interior of a row up to e <= n - radius, which it returns; the caller
+     * (src/smooth.c) does the borders and the rest (home__smooth_row_px). */
+    int (*smooth_row)(const float *in, float *out, int n, const float *taps, int radius);
+    /* out[i] = sum_k taps[k] * rows[k][i] (k = 0 .. 2 radius, in this order) for i in [0, e),
+     * e <= n returned; the caller does the rest (home__smooth_cols_px). */
+    int (*smooth_cols)(const float *const *rows, float *out, int n, const float *taps,
+                       int radius);
     /* One row of a ds x ds box downscale (ds = 2 or 4), rounded:
      *   out[x] = (sum over v, u < ds of src[v*stride + ds*x + u] + ds*ds/2) / (ds*ds),
      * x in [0, out_w). */
     void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
-    /* Hough extremum candidates: the indices i in [1, n - 1), increasing, where mid[i] > 0 and
+    /* Hough extremum candidates: the indices i in [1, e), increasing, where mid[i] > 0 and
      * above all eight neighbours in up, mid, down at i - 1 .. i + 1, or mid[i] < 0 and below
-     * them all, into idx; returns how many (comparisons only: exact in every backend). */
+     * them all (home__is_extremum), into idx; returns how many and sets *end = e <= n - 1 (at
+     * least 1); the caller (src/extrema.c) tests the rest. Comparisons only: exact everywhere. */
     int (*extremum_candidates)(const float *up, const float *mid, const float *down, int n,
-                               int *idx);
+                               int *idx, int *end);
     /* The line-end terms of a theta row's lines that cross the image's side, i in [i0, i1)
      * (src/hough.c's shear geometry: line j0 + i meets row p at column j0 + i + shift[p]):
      *   sum[i] += left[entry[i]] + right_total - right[after[i]]
@@ -91,15 +94,34 @@ extern const home__kernels home__kernels_sse;
 /* shared by the AVX2 table */
 void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
                            int *best, int *d1, int *d2);
-void home__smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius);
-void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
-                           int radius);
 void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
-int home__extremum_candidates_sse(const float *up, const float *mid, const float *down, int n,
-                                  int *idx);
 #endif
 
-/* The reference test of extremum_candidates at one index (scalar kernel and SIMD tails). */
+/* The references of smooth_row and smooth_cols for outputs [i0, i1) (the scalar kernels, and
+ * the callers for what the SIMD bodies leave). */
+static inline void home__smooth_row_px(const float *in, float *out, int i0, int i1,
+                                       const float *taps, int radius)
+{
+    int i, k;
+    for (i = i0; i < i1; i++) {
+        float acc = 0.0f;
+        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * in[i - radius + k];
+        out[i] = acc;
+    }
+}
+
+static inline void home__smooth_cols_px(const float *const *rows, float *out, int i0, int i1,
+                                        const float *taps, int radius)
+{
+    int i, k;
+    for (i = i0; i < i1; i++) {
+        float acc = 0.0f;
+        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * rows[k][i];
+        out[i] = acc;
+    }
+}
+
+/* The reference test of extremum_candidates at one index (scalar kernel and the callers). */
 static inline int home__is_extremum(const float *up, const float *mid, const float *down, int i)
 {
     const float v = mid[i];

@@ -89,6 +89,14 @@ static inline void home__blur3_horizontal(const int16_t *tmp, uint8_t *d, int x0
     d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
 }
 
+/* 2x2 means of row pair a, b for outputs [x0, w) (see downsample) */
+static inline void home__downsample_px(const uint8_t *a, const uint8_t *b, uint8_t *d, int x0, int w)
+{
+    int x;
+    for (x = x0; x < w; x++)
+        d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
+}
+
 /* block maxima for blocks [i0, n) (see block_max) */
 static inline void home__block_max_px(const int16_t *keys, int i0, int n, int b, uint16_t *cells)
 {

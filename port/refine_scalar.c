@@ -18,12 +18,11 @@ static void blur3_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
 static void downsample_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
                               ptrdiff_t dst_stride, int dst_w, int dst_h)
 {
-    int x, y;
+    int y;
     for (y = 0; y < dst_h; y++) {
         const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
         uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
-        for (x = 0; x < dst_w; x++)
-            d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
+        home__downsample_px(a, b, d, 0, dst_w);
     }
 }
 

@@ -80,11 +80,20 @@ int home__heap_sort_desc(home__heap *heap)
     return heap->count;
 }
 
+int home__extremum_candidates(const home__kernels *kernels, const float *up, const float *mid,
+                              const float *down, int n, int *idx)
+{
+    int end, count = kernels->extremum_candidates(up, mid, down, n, idx, &end);
+    for (; end < n - 1; end++) /* what the kernel left: the reference */
+        if (home__is_extremum(up, mid, down, end)) idx[count++] = end;
+    return count;
+}
+
 int home__detect_row(const home__kernels *kernels, const float *const *rows, int centre, int r_bins,
                      int theta_bins, int *candidates, home__extremum *out)
 {
     const float *up = rows[0], *mid = rows[1], *down = rows[2];
-    const int n_candidates = kernels->extremum_candidates(up, mid, down, r_bins, candidates);
+    const int n_candidates = home__extremum_candidates(kernels, up, mid, down, r_bins, candidates);
     int c, n = 0;
     for (c = 0; c < n_candidates; c++) {
         const int i = candidates[c];

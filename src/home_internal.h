@@ -182,6 +182,10 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
 int home__gauss_taps(float sigma, float *taps);
 void home__smooth_r(const home__kernels *kernels, const float *in, float *out, int n,
                     const float *taps, int radius);
+/* Along theta: out[i] = sum_k taps[k] rows[k][i], i in [0, n) (the smooth_cols kernel and the
+ * reference for what it leaves). */
+void home__smooth_theta(const home__kernels *kernels, const float *const *rows, float *out, int n,
+                        const float *taps, int radius);
 
 /* extrema.c */
 void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool, int capacity);
@@ -193,6 +197,10 @@ int home__heap_sort_desc(home__heap *heap);
 /* Scan smoothed row rows[1] (rows[0..2] = centre-1 .. centre+1) for strict extrema with a valid
  * Newton step whose refined theta lies in [0, theta_bins); returns how many were written.
  * candidates: r_bins ints of scratch. */
+/* The strict signed 3x3 extrema of row mid, i in [1, n - 1), into idx; how many (the kernel's
+ * body, then the reference for the rest). */
+int home__extremum_candidates(const home__kernels *kernels, const float *up, const float *mid,
+                              const float *down, int n, int *idx);
 int home__detect_row(const home__kernels *kernels, const float *const *rows, int centre, int r_bins,
                      int theta_bins, int *candidates, home__extremum *out);
 

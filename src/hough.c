@@ -302,8 +302,8 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
         j = k - radius; /* the theta-smoothed row now complete */
         for (i = 0; i < raw_ring; i++)
             raw_window[i] = ctx->raw_rows + (size_t)((j - radius + i - first_raw) % raw_ring) * r_bins;
-        ctx->kernels->smooth_cols(raw_window, ctx->smooth_rows +
-                               (size_t)((j - first_smooth) % HOME__DESC_ROWS) * r_bins,
+        home__smooth_theta(ctx->kernels, raw_window,
+                           ctx->smooth_rows + (size_t)((j - first_smooth) % HOME__DESC_ROWS) * r_bins,
                            r_bins, ctx->smooth_taps, radius);
         for (i = 0; i < HOME__DESC_ROWS; i++) {
             int row = j - (HOME__DESC_ROWS - 1) + i;

@@ -190,19 +190,19 @@ void test_kernels_smooth(void)
             rows[k] = in[k] + offset;
         }
         memset(want, 0, sizeof want);
-        home__kernels_scalar.smooth_row(in[0] + offset, want, n, taps, radius);
+        home__smooth_r(&home__kernels_scalar, in[0] + offset, want, n, taps, radius);
         for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
             const home__kernels *kr = home__kernels_for(backends[bi]);
             if (!kr) continue;
             memset(got, 0, sizeof got);
-            kr->smooth_row(in[0] + offset, got, n, taps, radius);
+            home__smooth_r(kr, in[0] + offset, got, n, taps, radius);
             CHECK(memcmp(want, got, sizeof want) == 0);
         }
-        home__kernels_scalar.smooth_cols(rows, want, n, taps, radius);
+        home__smooth_theta(&home__kernels_scalar, rows, want, n, taps, radius);
         for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
             const home__kernels *kr = home__kernels_for(backends[bi]);
             if (!kr) continue;
-            kr->smooth_cols(rows, got, n, taps, radius);
+            home__smooth_theta(kr, rows, got, n, taps, radius);
             CHECK(memcmp(want, got, (size_t)n * sizeof *got) == 0);
         }
     }
@@ -272,13 +272,13 @@ void test_kernels_extremum_candidates(void)
             if ((v > 0.0f && above) || (v < 0.0f && below)) want[want_n++] = i;
         }
         total += want_n;
-        count = home__kernels_scalar.extremum_candidates(up, mid, down, n, got);
+        count = home__extremum_candidates(&home__kernels_scalar, up, mid, down, n, got);
         CHECK_EQ_INT(count, want_n);
         CHECK(memcmp(want, got, (size_t)want_n * sizeof *want) == 0);
         for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
             const home__kernels *kr = home__kernels_for(backends[bi]);
             if (!kr) continue;
-            count = kr->extremum_candidates(up, mid, down, n, got);
+            count = home__extremum_candidates(kr, up, mid, down, n, got);
             CHECK_EQ_INT(count, want_n);
             CHECK(memcmp(want, got, (size_t)want_n * sizeof *want) == 0);
         }
