@@ -2,7 +2,7 @@
 # home-tests (stages, pipeline, kernels, trust), home-refine-tests, home-stab-tests,
 # home-hardening-tests (bad inputs, refusals) and home-fuzz-replay (the fuzz corpus through the
 # harnesses); fake_v4l2.so is the V4L2 device the capture loop is tested against.
-TEST_OBJ := $(patsubst %,$(BUILD)/obj/tests/%.o,test_main test_runner test_stages test_pipeline test_kernels test_trust)
+TEST_OBJ := $(patsubst %,$(BUILD)/obj/tests/%.o,test_main test_runner test_stages test_pipeline test_backends test_trust)
 HARD_TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/test_bad_input*.c))
 HARD_TESTS := $(BUILD)/bin/home-hardening-tests
 FUZZ_REPLAY := $(BUILD)/bin/home-fuzz-replay

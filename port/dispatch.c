@@ -55,53 +55,36 @@ int home__simd_resolve(int simd)
     }
 }
 
-const home__kernels *home__kernels_for(int simd)
-{
-    switch (home__simd_resolve(simd)) {
-    case HOME_SIMD_NONE: return &home__kernels_scalar;
+/* Each table lookup: the resolved backend's table of that kind (tables named
+ * <prefix>_scalar, _sse, _avx2, _neon), NULL when the resolver refuses. */
 #ifdef HOME__HAVE_SSE
-    case HOME_SIMD_SSE: return &home__kernels_sse;
+#define CASE_SSE(prefix) case HOME_SIMD_SSE: return &prefix##_sse;
+#else
+#define CASE_SSE(prefix)
 #endif
 #ifdef HOME__HAVE_AVX2
-    case HOME_SIMD_AVX2: return &home__kernels_avx2;
+#define CASE_AVX2(prefix) case HOME_SIMD_AVX2: return &prefix##_avx2;
+#else
+#define CASE_AVX2(prefix)
 #endif
 #ifdef HOME__HAVE_NEON
-    case HOME_SIMD_NEON: return &home__kernels_neon;
+#define CASE_NEON(prefix) case HOME_SIMD_NEON: return &prefix##_neon;
+#else
+#define CASE_NEON(prefix)
 #endif
-    default: return NULL;
+#define TABLE_FOR(type, prefix)                                                                  \
+    {                                                                                            \
+        switch (home__simd_resolve(simd)) {                                                      \
+        case HOME_SIMD_NONE: return &prefix##_scalar;                                            \
+        CASE_SSE(prefix) CASE_AVX2(prefix) CASE_NEON(prefix)                                     \
+        default: return (const type *)0;                                                         \
+        }                                                                                        \
     }
-}
+
+const home__kernels *home__kernels_for(int simd) TABLE_FOR(home__kernels, home__kernels)
 
 const home__refine_kernels *home__refine_kernels_for(int simd)
-{
-    switch (home__simd_resolve(simd)) {
-    case HOME_SIMD_NONE: return &home__refine_kernels_scalar;
-#ifdef HOME__HAVE_SSE
-    case HOME_SIMD_SSE: return &home__refine_kernels_sse;
-#endif
-#ifdef HOME__HAVE_AVX2
-    case HOME_SIMD_AVX2: return &home__refine_kernels_avx2;
-#endif
-#ifdef HOME__HAVE_NEON
-    case HOME_SIMD_NEON: return &home__refine_kernels_neon;
-#endif
-    default: return NULL;
-    }
-}
+    TABLE_FOR(home__refine_kernels, home__refine_kernels)
 
 const home__stab_kernels *home__stab_kernels_for(int simd)
-{
-    switch (home__simd_resolve(simd)) {
-    case HOME_SIMD_NONE: return &home__stab_kernels_scalar;
-#ifdef HOME__HAVE_SSE
-    case HOME_SIMD_SSE: return &home__stab_kernels_sse;
-#endif
-#ifdef HOME__HAVE_AVX2
-    case HOME_SIMD_AVX2: return &home__stab_kernels_avx2;
-#endif
-#ifdef HOME__HAVE_NEON
-    case HOME_SIMD_NEON: return &home__stab_kernels_neon;
-#endif
-    default: return NULL;
-    }
-}
+    TABLE_FOR(home__stab_kernels, home__stab_kernels)
