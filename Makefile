@@ -21,7 +21,7 @@ WARN := -Wall -Wextra -Werror -pedantic
 -include port/toolchain.mk
 SAN := $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer)
 CFLAGS_LIB := -std=c99 $(OPT) -g $(WARN) -Iinclude -Iport -fno-common $(ARCH_FLAGS) $(SAN) $(CFLAGS)
-CFLAGS_APP := -std=c99 $(OPT) -g $(WARN) -Iinclude -Iexamples $(ARCH_FLAGS) $(SAN) $(CFLAGS)
+CFLAGS_APP := -std=c99 $(OPT) -g $(WARN) -Iinclude -Iexamples -Itests/support $(ARCH_FLAGS) $(SAN) $(CFLAGS)
 LDFLAGS_APP := $(if $(SANITIZE),-fsanitize=$(SANITIZE)) $(LDFLAGS) -lm
 # every compile writes its header dependencies next to its object (read back at the end)
 DEPFLAGS := -MMD -MP

@@ -1,9 +1,11 @@
 # Programs on the library (examples/): home-register, home-make-pair, the stabiliser's home-stab
 # and home-stab-clip, the capture examples eis-v4l2 / eis-libcamera when their dependencies are
 # present, and the refinement's and the warp's bench tools.
-SUPPORT_OBJ := $(BUILD)/obj/examples/pgm.o $(BUILD)/obj/examples/synth.o
+# the scene and clip generators are test fixtures (tests/support/), which the pair and clip tools
+# and the benches share
+SUPPORT_OBJ := $(BUILD)/obj/examples/pgm.o $(BUILD)/obj/tests/support/synth.o
 STAB_SUPPORT := $(BUILD)/obj/examples/y4m.o $(BUILD)/obj/examples/stab_png.o \
-	$(BUILD)/obj/examples/stab_clip.o $(SUPPORT_OBJ)
+	$(BUILD)/obj/tests/support/stab_clip.o $(SUPPORT_OBJ)
 BINS += $(BUILD)/bin/home-register $(BUILD)/bin/home-make-pair $(BUILD)/bin/home-stab \
 	$(BUILD)/bin/home-stab-clip $(BUILD)/bin/home-refine-pair $(BUILD)/bin/home-warp-bands
 

@@ -2,7 +2,9 @@
 # home-tests (stages, pipeline, kernels, trust), home-refine-tests, home-stab-tests,
 # home-hardening-tests (bad inputs, refusals) and home-fuzz-replay (the fuzz corpus through the
 # harnesses); fake_v4l2.so is the V4L2 device the capture loop is tested against.
-TEST_OBJ := $(patsubst %,$(BUILD)/obj/tests/%.o,test_main test_runner test_stages test_pipeline test_backends test_trust)
+RUNNER_OBJ := $(BUILD)/obj/tests/support/test_runner.o
+TEST_OBJ := $(patsubst %,$(BUILD)/obj/tests/%.o,test_main test_stages test_pipeline test_backends test_trust) \
+	$(RUNNER_OBJ)
 HARD_TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/test_bad_input*.c))
 HARD_TESTS := $(BUILD)/bin/home-hardening-tests
 FUZZ_REPLAY := $(BUILD)/bin/home-fuzz-replay
@@ -21,7 +23,7 @@ $(BUILD)/bin/home-tests: $(TEST_OBJ) $(SUPPORT_OBJ) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
-$(BUILD)/bin/home-refine-tests: $(BUILD)/obj/tests/test_refine.o $(BUILD)/obj/tests/test_runner.o $(SUPPORT_OBJ) $(LIB)
+$(BUILD)/bin/home-refine-tests: $(BUILD)/obj/tests/test_refine.o $(RUNNER_OBJ) $(SUPPORT_OBJ) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
@@ -30,11 +32,11 @@ $(BUILD)/obj/tests/stab/test_stab.o: tests/test_stab.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $(DEPFLAGS) -Isrc -Iport -DHOME_STAB_TESTS -c $< -o $@
 
-$(BUILD)/bin/home-stab-tests: $(BUILD)/obj/tests/stab/test_stab.o $(BUILD)/obj/tests/test_runner.o $(STAB_SUPPORT) $(LIB)
+$(BUILD)/bin/home-stab-tests: $(BUILD)/obj/tests/stab/test_stab.o $(RUNNER_OBJ) $(STAB_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
-$(HARD_TESTS): $(HARD_TEST_OBJ) $(BUILD)/obj/tests/test_runner.o $(FUZZ_SUPPORT) $(LIB)
+$(HARD_TESTS): $(HARD_TEST_OBJ) $(RUNNER_OBJ) $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) -pthread
 

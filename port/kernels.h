@@ -1,6 +1,6 @@
 /* libhome's hot kernels: one table per SIMD backend, chosen per context at home_init().
  * Every backend must produce bit-identical results to the scalar reference (integer kernels),
- * which tests/test_kernels.c checks on odd sizes, unaligned pointers and extreme inputs. */
+ * which tests/test_backends.c checks on odd sizes, unaligned pointers and extreme inputs. */
 #ifndef HOME_KERNELS_H
 #define HOME_KERNELS_H
 #include "line_fit_kernels.h"

@@ -2,7 +2,7 @@
  * context like home__kernels. Integer kernels are bit-identical to the scalar reference; the
  * float kernels are too, because every backend runs the same IEEE operations in the same order
  * on the same lane (point i is lane i % 4; no fused multiply-add, C99 contracts none), which
- * tests/test_refine.c checks on odd sizes and unaligned pointers. */
+ * tests/test_backends.c checks on odd sizes and unaligned pointers. */
 #ifndef HOME_REFINE_KERNELS_H
 #define HOME_REFINE_KERNELS_H
 #include <stddef.h>

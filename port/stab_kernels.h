@@ -1,6 +1,6 @@
 /* Kernels of the stabiliser's warp (src/warp.c): one table per SIMD backend, chosen like
  * home__kernels. Every backend gives the scalar reference's bytes exactly (integer arithmetic),
- * which tests/test_stab.c checks on odd widths, unaligned pointers and clamped rows. */
+ * which tests/test_backends.c checks on odd widths, unaligned pointers and clamped rows. */
 #ifndef HOME_STAB_KERNELS_H
 #define HOME_STAB_KERNELS_H
 #include <stddef.h>
