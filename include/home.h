@@ -59,7 +59,13 @@ typedef double (*home_clock_fn)(void *user);
  * takes the environment variable HOME_SIMD=none|sse|avx2|neon when set (compile the library
  * with -DHOME_NO_GETENV for targets without an environment), else picks NEON on ARM, AVX2 on
  * x86-64 CPUs that have it (SSE2 for everything but the Hough kernel), else SSE2. */
-enum home_simd { HOME_SIMD_AUTO = 0, HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_NEON, HOME_SIMD_AVX2 };
+enum home_simd {
+    HOME_SIMD_AUTO = 0,
+    HOME_SIMD_NONE,
+    HOME_SIMD_SSE,
+    HOME_SIMD_NEON,
+    HOME_SIMD_AVX2
+};
 
 /* How J(theta, r) is computed. FAST: shear-and-add line sums of the image (one channel, exact
  * integer sums along nearest-pixel digital lines, SIMD), differentiated across lines with the

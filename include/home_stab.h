@@ -5,12 +5,13 @@
  * (home_config.max_model), which it fits as a similarity (translation, rotation, zoom about the
  * image centre); accumulates the camera path; smooths it with a constant-velocity Kalman filter
  * (each frame's measurement noise grows with the registration's predicted error sigma_px, so an
- * uncertain motion pulls the path less; a static scene registers as exactly no motion) and, with a lookahead of N frames, a
- * fixed-lag Rauch-Tung-Striebel smoother over those N frames; and returns the warp that shows
- * the smoothed camera through a crop window (margin m on each side, scaled to fill the frame).
- * The correction is shrunk towards identity whenever the window would leave the frame, so the
- * output never shows pixels from outside the input. A failed or implausible registration is
- * taken as "no motion": the path holds and the correction decays smoothly towards identity.
+ * uncertain motion pulls the path less; a static scene registers as exactly no motion) and, with a
+ * lookahead of N frames, a fixed-lag Rauch-Tung-Striebel smoother over those N frames; and returns
+ * the warp that shows the smoothed camera through a crop window (margin m on each side, scaled to
+ * fill the frame). The correction is shrunk towards identity whenever the window would leave the
+ * frame, so the output never shows pixels from outside the input. A failed or implausible
+ * registration is taken as "no motion": the path holds and the correction decays smoothly towards
+ * identity.
  *
  * Frames, latency and memory: the caller owns every frame buffer. home_stab_push() takes the
  * newest frame (only its luma is read) and, once N = lookahead frames are queued behind it,
@@ -162,8 +163,8 @@ int home_stab_warp(const double *warp, const home_stab_image *src, home_stab_ima
  * chroma rows): the same bytes there, nothing else written. Bands on several threads split the
  * warp across cores (the library keeps no state: any thread may call it). I420 and NV12 bands
  * start and end on an even row; HOME_E_CONFIG otherwise or outside the frame. */
-int home_stab_warp_rows(const double *warp, const home_stab_image *src, home_stab_image *dst, int first_row,
-                        int rows);
+int home_stab_warp_rows(const double *warp, const home_stab_image *src, home_stab_image *dst,
+                        int first_row, int rows);
 
 /* Similarity parameters <-> 3x3 matrices (about the centre of a width x height frame). */
 void home_stab_sim_to_matrix(const home_stab_sim *s, int width, int height, double *m);

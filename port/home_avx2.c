@@ -18,14 +18,20 @@ static void radon_blocks_avx2(const uint8_t *base, ptrdiff_t stride, const int16
         for (k = 0; k < HOME__RADON_BLOCK; k += 8)
             _mm256_storeu_si256((__m256i *)(void *)(acc32 + k), _mm256_setzero_si256());
         while (p <= row_hi[b]) {
-            int end = p + HOME__RADON_ROWS_16BIT - 1 < row_hi[b] ? p + HOME__RADON_ROWS_16BIT - 1 : row_hi[b];
+            int end = p + HOME__RADON_ROWS_16BIT - 1 < row_hi[b] ? p + HOME__RADON_ROWS_16BIT - 1
+                                                                 : row_hi[b];
             __m256i a0 = _mm256_setzero_si256(), a1 = a0, a2 = a0, a3 = a0;
             for (; p <= end; p++) {
-                const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK + shift[p];
-                a0 = _mm256_add_epi16(a0, _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(const void *)src)));
-                a1 = _mm256_add_epi16(a1, _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(const void *)(src + 16))));
-                a2 = _mm256_add_epi16(a2, _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(const void *)(src + 32))));
-                a3 = _mm256_add_epi16(a3, _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(const void *)(src + 48))));
+                const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK +
+                                     shift[p];
+                a0 = _mm256_add_epi16(
+                    a0, _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(const void *)src)));
+                a1 = _mm256_add_epi16(a1, _mm256_cvtepu8_epi16(_mm_loadu_si128(
+                                              (const __m128i *)(const void *)(src + 16))));
+                a2 = _mm256_add_epi16(a2, _mm256_cvtepu8_epi16(_mm_loadu_si128(
+                                              (const __m128i *)(const void *)(src + 32))));
+                a3 = _mm256_add_epi16(a3, _mm256_cvtepu8_epi16(_mm_loadu_si128(
+                                              (const __m128i *)(const void *)(src + 48))));
             }
             {
                 __m256i acc[4];
@@ -53,9 +59,11 @@ static int smooth_row_avx2(const float *in, float *out, int n, const float *taps
 {
     int i = radius, k;
     if (radius == 4) {
-        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]), t2 = _mm256_set1_ps(taps[2]),
-                     t3 = _mm256_set1_ps(taps[3]), t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
-                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]), t8 = _mm256_set1_ps(taps[8]);
+        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]),
+                     t2 = _mm256_set1_ps(taps[2]), t3 = _mm256_set1_ps(taps[3]),
+                     t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
+                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]),
+                     t8 = _mm256_set1_ps(taps[8]);
         for (; i + 8 <= n - radius; i += 8) {
             const float *p = in + i - 4;
             __m256 acc = _mm256_setzero_ps();
@@ -68,7 +76,8 @@ static int smooth_row_avx2(const float *in, float *out, int n, const float *taps
     for (; i + 8 <= n - radius; i += 8) {
         __m256 acc = _mm256_setzero_ps();
         for (k = 0; k <= 2 * radius; k++)
-            acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(in + i - radius + k)));
+            acc = _mm256_add_ps(
+                acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(in + i - radius + k)));
         _mm256_storeu_ps(out + i, acc);
     }
     return i;
@@ -79,15 +88,23 @@ static int smooth_cols_avx2(const float *const *rows, float *out, int n, const f
 {
     int i = 0, k;
     if (radius == 4) {
-        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]), t2 = _mm256_set1_ps(taps[2]),
-                     t3 = _mm256_set1_ps(taps[3]), t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
-                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]), t8 = _mm256_set1_ps(taps[8]);
+        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]),
+                     t2 = _mm256_set1_ps(taps[2]), t3 = _mm256_set1_ps(taps[3]),
+                     t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
+                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]),
+                     t8 = _mm256_set1_ps(taps[8]);
         const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4],
                     *r5 = rows[5], *r6 = rows[6], *r7 = rows[7], *r8 = rows[8];
         for (; i + 8 <= n; i += 8) {
             __m256 acc = _mm256_setzero_ps();
-            SMOOTH_TAP(0, r0 + i); SMOOTH_TAP(1, r1 + i); SMOOTH_TAP(2, r2 + i); SMOOTH_TAP(3, r3 + i);
-            SMOOTH_TAP(4, r4 + i); SMOOTH_TAP(5, r5 + i); SMOOTH_TAP(6, r6 + i); SMOOTH_TAP(7, r7 + i);
+            SMOOTH_TAP(0, r0 + i);
+            SMOOTH_TAP(1, r1 + i);
+            SMOOTH_TAP(2, r2 + i);
+            SMOOTH_TAP(3, r3 + i);
+            SMOOTH_TAP(4, r4 + i);
+            SMOOTH_TAP(5, r5 + i);
+            SMOOTH_TAP(6, r6 + i);
+            SMOOTH_TAP(7, r7 + i);
             SMOOTH_TAP(8, r8 + i);
             _mm256_storeu_ps(out + i, acc);
         }
@@ -95,7 +112,8 @@ static int smooth_cols_avx2(const float *const *rows, float *out, int n, const f
     for (; i + 8 <= n; i += 8) {
         __m256 acc = _mm256_setzero_ps();
         for (k = 0; k <= 2 * radius; k++)
-            acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(rows[k] + i)));
+            acc = _mm256_add_ps(
+                acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(rows[k] + i)));
         _mm256_storeu_ps(out + i, acc);
     }
     return i;
@@ -110,15 +128,19 @@ static int extremum_candidates_avx2(const float *up, const float *mid, const flo
     int i, count = 0;
     for (i = 1; i + 8 <= n - 1; i += 8) {
         __m256 v = _mm256_loadu_ps(mid + i);
-        __m256 a = _mm256_loadu_ps(up + i - 1), b = _mm256_loadu_ps(up + i), c = _mm256_loadu_ps(up + i + 1);
+        __m256 a = _mm256_loadu_ps(up + i - 1), b = _mm256_loadu_ps(up + i),
+               c = _mm256_loadu_ps(up + i + 1);
         __m256 d = _mm256_loadu_ps(mid + i - 1), e = _mm256_loadu_ps(mid + i + 1);
-        __m256 f = _mm256_loadu_ps(down + i - 1), g = _mm256_loadu_ps(down + i), h = _mm256_loadu_ps(down + i + 1);
+        __m256 f = _mm256_loadu_ps(down + i - 1), g = _mm256_loadu_ps(down + i),
+               h = _mm256_loadu_ps(down + i + 1);
         __m256 hi = _mm256_max_ps(_mm256_max_ps(_mm256_max_ps(a, b), _mm256_max_ps(c, d)),
                                   _mm256_max_ps(_mm256_max_ps(e, f), _mm256_max_ps(g, h)));
         __m256 lo = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(a, b), _mm256_min_ps(c, d)),
                                   _mm256_min_ps(_mm256_min_ps(e, f), _mm256_min_ps(g, h)));
-        __m256 pos = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, hi, _CMP_GT_OQ));
-        __m256 neg = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_LT_OQ), _mm256_cmp_ps(v, lo, _CMP_LT_OQ));
+        __m256 pos = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ),
+                                   _mm256_cmp_ps(v, hi, _CMP_GT_OQ));
+        __m256 neg = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_LT_OQ),
+                                   _mm256_cmp_ps(v, lo, _CMP_LT_OQ));
         int mask = _mm256_movemask_ps(_mm256_or_ps(pos, neg)), lane;
         for (lane = 0; mask; lane++, mask >>= 1)
             if (mask & 1) idx[count++] = i + lane;
@@ -136,17 +158,22 @@ static void line_ends_avx2(const uint8_t *base, ptrdiff_t stride, const int16_t 
                            int32_t *sum, float *line)
 {
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), one = _mm256_set1_epi32(1);
-    const __m256i vstride = _mm256_set1_epi32((int32_t)stride), total = _mm256_set1_epi32(right_total);
+    const __m256i vstride = _mm256_set1_epi32((int32_t)stride),
+                  total = _mm256_set1_epi32(right_total);
     const __m256i low_byte = _mm256_set1_epi32(0xff);
     const int *shift_words = (const int *)(const void *)shift;
     int i = i0;
     for (; i + 8 <= i1; i += 8) {
-        const __m256i e = _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(entry + i)));
-        const __m256i a = _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(after + i)));
+        const __m256i e =
+            _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(entry + i)));
+        const __m256i a =
+            _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(after + i)));
         const __m256i inside = _mm256_cmpgt_epi32(a, e), zero = _mm256_setzero_si256();
-        const __m256i j = _mm256_add_epi32(_mm256_set1_epi32(j0 + i), lane), last = _mm256_sub_epi32(a, one);
-        __m256i border = _mm256_sub_epi32(_mm256_add_epi32(_mm256_i32gather_epi32(left, e, 4), total),
-                                          _mm256_i32gather_epi32(right, a, 4));
+        const __m256i j = _mm256_add_epi32(_mm256_set1_epi32(j0 + i), lane),
+                      last = _mm256_sub_epi32(a, one);
+        __m256i border =
+            _mm256_sub_epi32(_mm256_add_epi32(_mm256_i32gather_epi32(left, e, 4), total),
+                             _mm256_i32gather_epi32(right, a, 4));
         __m256i s_first = _mm256_mask_i32gather_epi32(zero, shift_words, e, inside, 2);
         __m256i s_last = _mm256_mask_i32gather_epi32(zero, shift_words, last, inside, 2);
         __m256i at_first, at_last, p_first, p_last;
@@ -155,8 +182,9 @@ static void line_ends_avx2(const uint8_t *base, ptrdiff_t stride, const int16_t 
         s_last = _mm256_srai_epi32(_mm256_slli_epi32(s_last, 16), 16);
         at_first = _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(e, vstride), j), s_first);
         at_last = _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(last, vstride), j), s_last);
-        p_first = _mm256_and_si256(_mm256_mask_i32gather_epi32(zero, (const int *)(const void *)base,
-                                                               at_first, inside, 1), low_byte);
+        p_first = _mm256_and_si256(
+            _mm256_mask_i32gather_epi32(zero, (const int *)(const void *)base, at_first, inside, 1),
+            low_byte);
         p_last = _mm256_and_si256(_mm256_mask_i32gather_epi32(zero, (const int *)(const void *)base,
                                                               at_last, inside, 1), low_byte);
         _mm256_storeu_si256(sum_at, _mm256_add_epi32(_mm256_loadu_si256(sum_at), border));
@@ -171,8 +199,10 @@ static void resample_avx2(const float *line, const int16_t *k, const float *f, i
 {
     int i = 0;
     for (; i + 8 <= n; i += 8) {
-        const __m256i kk = _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(k + i)));
-        const __m256 lo = _mm256_i32gather_ps(line, kk, 4), hi = _mm256_i32gather_ps(line + 1, kk, 4);
+        const __m256i kk =
+            _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(k + i)));
+        const __m256 lo = _mm256_i32gather_ps(line, kk, 4),
+                     hi = _mm256_i32gather_ps(line + 1, kk, 4);
         _mm256_storeu_ps(out + i, _mm256_add_ps(lo, _mm256_mul_ps(_mm256_loadu_ps(f + i),
                                                                   _mm256_sub_ps(hi, lo))));
     }
@@ -193,15 +223,20 @@ static void box_down_avx2(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t 
             __m256i lo = _mm256_setzero_si256(), hi = lo;
             for (v = 0; v < 4; v++) {
                 const uint8_t *row = s0 + (ptrdiff_t)v * stride;
-                lo = _mm256_add_epi16(lo, _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)row), ones8));
-                hi = _mm256_add_epi16(hi, _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(row + 32)), ones8));
+                lo = _mm256_add_epi16(
+                    lo, _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)row),
+                                             ones8));
+                hi = _mm256_add_epi16(
+                    hi, _mm256_maddubs_epi16(
+                            _mm256_loadu_si256((const __m256i *)(const void *)(row + 32)), ones8));
             }
             lo = _mm256_srai_epi32(_mm256_add_epi32(_mm256_madd_epi16(lo, ones16), half), 4);
             hi = _mm256_srai_epi32(_mm256_add_epi32(_mm256_madd_epi16(hi, ones16), half), 4);
             /* packs per 128-bit lane: lo0 hi0 lo1 hi1 in order 0 2 1 3 after the pack */
             lo = _mm256_permute4x64_epi64(_mm256_packs_epi32(lo, hi), 0xD8);
             _mm_storeu_si128((__m128i *)(void *)(out + x),
-                             _mm256_castsi256_si128(_mm256_permute4x64_epi64(_mm256_packus_epi16(lo, lo), 0xD8)));
+                             _mm256_castsi256_si128(
+                                 _mm256_permute4x64_epi64(_mm256_packus_epi16(lo, lo), 0xD8)));
         }
     } else {
         const __m256i half = _mm256_set1_epi16(2);
@@ -209,10 +244,12 @@ static void box_down_avx2(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t 
             const uint8_t *s0 = src + 2 * x;
             __m256i sum = _mm256_add_epi16(
                 _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)s0), ones8),
-                _mm256_maddubs_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(s0 + stride)), ones8));
+                _mm256_maddubs_epi16(
+                    _mm256_loadu_si256((const __m256i *)(const void *)(s0 + stride)), ones8));
             sum = _mm256_srai_epi16(_mm256_add_epi16(sum, half), 2);
             _mm_storeu_si128((__m128i *)(void *)(out + x),
-                             _mm256_castsi256_si128(_mm256_permute4x64_epi64(_mm256_packus_epi16(sum, sum), 0xD8)));
+                             _mm256_castsi256_si128(
+                                 _mm256_permute4x64_epi64(_mm256_packus_epi16(sum, sum), 0xD8)));
         }
     }
     if (x < out_w) home__box_down_sse(src + ds * x, stride, ds, out + x, out_w - x);

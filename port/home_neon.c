@@ -16,11 +16,13 @@ static void radon_blocks_neon(const uint8_t *base, ptrdiff_t stride, const int16
         int p = row_lo[b];
         for (k = 0; k < HOME__RADON_BLOCK; k += 4) vst1q_s32(acc32 + k, vdupq_n_s32(0));
         while (p <= row_hi[b]) {
-            int end = p + HOME__RADON_ROWS_16BIT - 1 < row_hi[b] ? p + HOME__RADON_ROWS_16BIT - 1 : row_hi[b];
+            int end = p + HOME__RADON_ROWS_16BIT - 1 < row_hi[b] ? p + HOME__RADON_ROWS_16BIT - 1
+                                                                 : row_hi[b];
             uint16x8_t a[8];
             for (k = 0; k < 8; k++) a[k] = vdupq_n_u16(0);
             for (; p <= end; p++) {
-                const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK + shift[p];
+                const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK +
+                                     shift[p];
                 for (k = 0; k < 4; k++) {
                     uint8x16_t v = vld1q_u8(src + 16 * k);
                     a[2 * k] = vaddw_u8(a[2 * k], vget_low_u8(v));
@@ -29,8 +31,11 @@ static void radon_blocks_neon(const uint8_t *base, ptrdiff_t stride, const int16
             }
             for (k = 0; k < 8; k++) {
                 int32_t *dst = acc32 + 8 * k;
-                vst1q_s32(dst, vaddq_s32(vld1q_s32(dst), vreinterpretq_s32_u32(vmovl_u16(vget_low_u16(a[k])))));
-                vst1q_s32(dst + 4, vaddq_s32(vld1q_s32(dst + 4), vreinterpretq_s32_u32(vmovl_u16(vget_high_u16(a[k])))));
+                vst1q_s32(dst, vaddq_s32(vld1q_s32(dst),
+                                         vreinterpretq_s32_u32(vmovl_u16(vget_low_u16(a[k])))));
+                vst1q_s32(dst + 4,
+                          vaddq_s32(vld1q_s32(dst + 4),
+                                    vreinterpretq_s32_u32(vmovl_u16(vget_high_u16(a[k])))));
             }
         }
     }

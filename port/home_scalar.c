@@ -11,7 +11,8 @@ static void radon_blocks_scalar(const uint8_t *base, ptrdiff_t stride, const int
         int32_t *acc = out + (ptrdiff_t)b * HOME__RADON_BLOCK;
         memset(acc, 0, HOME__RADON_BLOCK * sizeof *acc);
         for (p = row_lo[b]; p <= row_hi[b]; p++) {
-            const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK + shift[p];
+            const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK +
+                                 shift[p];
             for (l = 0; l < HOME__RADON_BLOCK; l++) acc[l] += src[l];
         }
     }

@@ -14,13 +14,16 @@ static void radon_blocks_sse(const uint8_t *base, ptrdiff_t stride, const int16_
     for (b = 0; b < n_blocks; b++) {
         int32_t *acc32 = out + (ptrdiff_t)b * HOME__RADON_BLOCK;
         int p = row_lo[b];
-        for (k = 0; k < HOME__RADON_BLOCK; k += 4) _mm_storeu_si128((__m128i *)(void *)(acc32 + k), zero);
+        for (k = 0; k < HOME__RADON_BLOCK; k += 4)
+            _mm_storeu_si128((__m128i *)(void *)(acc32 + k), zero);
         while (p <= row_hi[b]) {
-            int end = p + HOME__RADON_ROWS_16BIT - 1 < row_hi[b] ? p + HOME__RADON_ROWS_16BIT - 1 : row_hi[b];
+            int end = p + HOME__RADON_ROWS_16BIT - 1 < row_hi[b] ? p + HOME__RADON_ROWS_16BIT - 1
+                                                                 : row_hi[b];
             __m128i a[8];
             for (k = 0; k < 8; k++) a[k] = zero;
             for (; p <= end; p++) {
-                const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK + shift[p];
+                const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK +
+                                     shift[p];
                 for (k = 0; k < 4; k++) {
                     __m128i v = _mm_loadu_si128((const __m128i *)(const void *)(src + 16 * k));
                     a[2 * k] = _mm_add_epi16(a[2 * k], _mm_unpacklo_epi8(v, zero));
@@ -69,7 +72,8 @@ void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *o
             if (ds == 4) {
                 __m128i lo = zero, hi = zero;
                 for (v = 0; v < 4; v++) {
-                    __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(s0 + (ptrdiff_t)v * stride));
+                    __m128i b = _mm_loadu_si128(
+                        (const __m128i *)(const void *)(s0 + (ptrdiff_t)v * stride));
                     lo = _mm_add_epi16(lo, _mm_unpacklo_epi8(b, zero));
                     hi = _mm_add_epi16(hi, _mm_unpackhi_epi8(b, zero));
                 }
@@ -78,12 +82,14 @@ void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *o
             } else {
                 __m128i b0 = _mm_loadl_epi64((const __m128i *)(const void *)s0);
                 __m128i b1 = _mm_loadl_epi64((const __m128i *)(const void *)(s0 + stride));
-                q[c] = _mm_madd_epi16(_mm_add_epi16(_mm_unpacklo_epi8(b0, zero), _mm_unpacklo_epi8(b1, zero)), ones);
+                q[c] = _mm_madd_epi16(
+                    _mm_add_epi16(_mm_unpacklo_epi8(b0, zero), _mm_unpacklo_epi8(b1, zero)), ones);
             }
             q[c] = _mm_srai_epi32(_mm_add_epi32(q[c], half), shift);
         }
-        _mm_storeu_si128((__m128i *)(void *)(out + x),
-                         _mm_packus_epi16(_mm_packs_epi32(q[0], q[1]), _mm_packs_epi32(q[2], q[3])));
+        _mm_storeu_si128(
+            (__m128i *)(void *)(out + x),
+            _mm_packus_epi16(_mm_packs_epi32(q[0], q[1]), _mm_packs_epi32(q[2], q[3])));
     }
     if (x < out_w) home__kernels_scalar.box_down(src + ds * x, stride, ds, out + x, out_w - x);
 }

@@ -23,8 +23,9 @@ typedef struct line_lanes {
 /* Residuals e (3 components) of matches m[0..FIT_LANES) at g; lanes with valid 0 get e = k = 0.
  * With jacobian, also the numbers de/dg is made of: with l the line in A, rows 0..2 of de/dg
  * are (k0 l, k1 l, 0, 0), (k1 l, k2 l, 0, 0) and (k3 l, k4 l, k5 l0, k5 l1). */
-static void line_residuals(const home__line_problem *lp, const home__match *const *m, const double *valid,
-                           const double *restrict g, int jacobian, line_lanes *restrict out)
+static void line_residuals(const home__line_problem *lp, const home__match *const *m,
+                           const double *valid, const double *restrict g, int jacobian,
+                           line_lanes *restrict out)
 {
     double a[FIT_LANES], b[FIT_LANES], c[FIT_LANES], inv_n[FIT_LANES], cb[FIT_LANES],
         sb[FIT_LANES], rb[FIT_LANES];
@@ -134,7 +135,8 @@ static double line_normal(const void *user, const double *g, double *jtj, double
             for (u = 0; u < 6; u++)
                 sum[t][u] = (blk[t][u][0] + blk[t][u][1]) + (blk[t][u][2] + blk[t][u][3]);
         for (t = 0; t < 3; t++)
-            for (u = 0; u < 3; u++) evs[t][u] = (ev[t][u][0] + ev[t][u][1]) + (ev[t][u][2] + ev[t][u][3]);
+            for (u = 0; u < 3; u++)
+                evs[t][u] = (ev[t][u][0] + ev[t][u][1]) + (ev[t][u][2] + ev[t][u][3]);
         for (t = 0; t < 3; t++) {
             for (u = 0; u < 3; u++) {
                 const int q = ll_index[t][u];

@@ -21,8 +21,9 @@ F4_LINKAGE void F4_NAME(warp)(const float *m, const int16_t *xs, const int16_t *
         const home__f4 inv = F4_DIV(F4_SET1(1.0f), d);
         home__f4 px = F4_MUL(F4_ADD(F4_ADD(F4_MUL(mm[0], x), F4_MUL(mm[1], y)), mm[2]), inv);
         home__f4 py = F4_MUL(F4_ADD(F4_ADD(F4_MUL(mm[3], x), F4_MUL(mm[4], y)), mm[5]), inv);
-        const home__m4 ok = M4_AND(M4_AND(F4_GT(d, zero), F4_GE(px, zero)),
-                                   M4_AND(F4_GE(py, zero), M4_AND(F4_LT(px, xmax), F4_LT(py, ymax))));
+        const home__m4 ok =
+            M4_AND(M4_AND(F4_GT(d, zero), F4_GE(px, zero)),
+                   M4_AND(F4_GE(py, zero), M4_AND(F4_LT(px, xmax), F4_LT(py, ymax))));
         home__i4 ix, iy;
         home__f4 fx, fy, top, bot;
         int32_t cx[4], cy[4];

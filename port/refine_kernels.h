@@ -11,7 +11,8 @@
 #define HOME__REFINE_LANES 4
 #define HOME__REFINE_ACC 44   /* 36 upper-triangle entries of J^T W J, then 8 of J^T W r */
 
-/* Bytes readable past the last pixel of an image the warp samples (the pyramid levels have them). */
+/* Bytes readable past the last pixel of an image the warp samples (the pyramid levels have them).
+ */
 #define HOME__REFINE_IMAGE_SLACK 4
 
 typedef struct home__refine_kernels {
@@ -90,7 +91,8 @@ static inline void home__blur3_horizontal(const int16_t *tmp, uint8_t *d, int x0
 }
 
 /* 2x2 means of row pair a, b for outputs [x0, w) (see downsample) */
-static inline void home__downsample_px(const uint8_t *a, const uint8_t *b, uint8_t *d, int x0, int w)
+static inline void home__downsample_px(const uint8_t *a, const uint8_t *b, uint8_t *d, int x0,
+                                       int w)
 {
     int x;
     for (x = x0; x < w; x++)

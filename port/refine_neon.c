@@ -41,7 +41,8 @@ static void downsample_neon(const uint8_t *src, ptrdiff_t src_stride, uint8_t *d
         const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
         uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
         for (x = 0; x + 8 <= dst_w; x += 8) {
-            uint16x8_t s = vaddq_u16(vpaddlq_u8(vld1q_u8(a + 2 * x)), vpaddlq_u8(vld1q_u8(b + 2 * x)));
+            uint16x8_t s = vaddq_u16(vpaddlq_u8(vld1q_u8(a + 2 * x)),
+                                     vpaddlq_u8(vld1q_u8(b + 2 * x)));
             vst1_u8(d + x, vmovn_u16(vshrq_n_u16(vaddq_u16(s, vdupq_n_u16(2)), 2)));
         }
         home__downsample_px(a, b, d, x, dst_w);

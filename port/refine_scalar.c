@@ -47,7 +47,8 @@ static void warp_scalar(const float *m, const int16_t *xs, const int16_t *ys, in
             int ix = (int)px, iy = (int)py;
             float fx = px - (float)ix, fy = py - (float)iy;
             const uint8_t *p = img + (ptrdiff_t)iy * stride + ix;
-            float p00 = (float)p[0], p01 = (float)p[1], p10 = (float)p[stride], p11 = (float)p[stride + 1];
+            float p00 = (float)p[0], p01 = (float)p[1], p10 = (float)p[stride],
+                  p11 = (float)p[stride + 1];
             float top = p00 + fx * (p01 - p00);
             float bot = p10 + fx * (p11 - p10);
             out[i] = top + fy * (bot - top);

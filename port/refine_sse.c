@@ -9,7 +9,8 @@
 
 static __m128i load8_u16(const uint8_t *p)
 {
-    return _mm_unpacklo_epi8(_mm_loadl_epi64((const __m128i *)(const void *)p), _mm_setzero_si128());
+    return _mm_unpacklo_epi8(_mm_loadl_epi64((const __m128i *)(const void *)p),
+                             _mm_setzero_si128());
 }
 
 static void blur3_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst, ptrdiff_t dst_stride,
@@ -23,7 +24,8 @@ static void blur3_sse(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst, pt
         home__blur3_rows(src, src_stride, y, h, &a, &b, &c);
         for (x = 0; x + 8 <= w; x += 8) {
             __m128i vb = load8_u16(b + x);
-            __m128i s = _mm_add_epi16(_mm_add_epi16(load8_u16(a + x), load8_u16(c + x)), _mm_add_epi16(vb, vb));
+            __m128i s = _mm_add_epi16(_mm_add_epi16(load8_u16(a + x), load8_u16(c + x)),
+                                      _mm_add_epi16(vb, vb));
             _mm_storeu_si128((__m128i *)(void *)(tmp + x), s);
         }
         home__blur3_vertical(a, b, c, tmp, x, w);
@@ -63,20 +65,23 @@ static __m128i absdiff8(const uint8_t *p, const uint8_t *q)
 {
     __m128i a = _mm_loadl_epi64((const __m128i *)(const void *)p);
     __m128i b = _mm_loadl_epi64((const __m128i *)(const void *)q);
-    return _mm_unpacklo_epi8(_mm_or_si128(_mm_subs_epu8(a, b), _mm_subs_epu8(b, a)), _mm_setzero_si128());
+    return _mm_unpacklo_epi8(_mm_or_si128(_mm_subs_epu8(a, b), _mm_subs_epu8(b, a)),
+                             _mm_setzero_si128());
 }
 
 static void select_keys_sse(const uint8_t *row, ptrdiff_t stride, int w, int b, int dy,
                             int16_t *keys, int accumulate)
 {
-    const __m128i iota = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7), mask = _mm_set1_epi16((short)(b - 1));
+    const __m128i iota = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7),
+                  mask = _mm_set1_epi16((short)(b - 1));
     const __m128i base = _mm_set1_epi16((short)(dy * b));
     int x;
     if (!accumulate) keys[0] = keys[w - 1] = 0;
     for (x = 1; x + 8 <= w - 1; x += 8) {
         __m128i s = _mm_add_epi16(absdiff8(row + x + 1, row + x - 1),
                                   absdiff8(row + x + stride, row + x - stride));
-        __m128i off = _mm_add_epi16(base, _mm_and_si128(_mm_add_epi16(_mm_set1_epi16((short)x), iota), mask));
+        __m128i off =
+            _mm_add_epi16(base, _mm_and_si128(_mm_add_epi16(_mm_set1_epi16((short)x), iota), mask));
         __m128i key = _mm_or_si128(_mm_slli_epi16(s, 4), off);
         __m128i *dst = (__m128i *)(void *)(keys + x);
         if (accumulate) key = _mm_max_epi16(key, _mm_loadu_si128(dst));
@@ -110,8 +115,9 @@ void home__refine_block_max_sse(const int16_t *keys, int n, int b, uint16_t *cel
                 q[j] = _mm_and_si128(_mm_max_epi16(v, _mm_srli_epi64(v, 32)), low64);
             }
             /* 32-bit lanes 0 and 2 of each hold two blocks' maxima: pack twice */
-            _mm_storeu_si128((__m128i *)(void *)(cells + i),
-                             _mm_packs_epi32(_mm_packs_epi32(q[0], q[1]), _mm_packs_epi32(q[2], q[3])));
+            _mm_storeu_si128(
+                (__m128i *)(void *)(cells + i),
+                _mm_packs_epi32(_mm_packs_epi32(q[0], q[1]), _mm_packs_epi32(q[2], q[3])));
         }
     }
     home__block_max_px(keys, i, n, b, cells);

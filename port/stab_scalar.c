@@ -18,16 +18,18 @@ static void warp_row_inside(const uint8_t *src, ptrdiff_t stride, int step, int3
 {
     int i;
     for (i = 0; i < n; i++, x += dx, y += dy)
-        dst[(ptrdiff_t)i * dst_step] =
-            blend(src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride + (ptrdiff_t)(x >> HOME__WARP_FRAC_BITS) * step,
-                  stride, step, HOME__WARP_WEIGHT(x & 0xffff), HOME__WARP_WEIGHT(y & 0xffff));
+        dst[(ptrdiff_t)i * dst_step] = blend(src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride +
+                                                 (ptrdiff_t)(x >> HOME__WARP_FRAC_BITS) * step,
+                                             stride, step, HOME__WARP_WEIGHT(x & 0xffff),
+                                             HOME__WARP_WEIGHT(y & 0xffff));
 }
 
 int home__warp_row_inside(int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, int n)
 {
     const int32_t x_max = (int32_t)(w - 1) << HOME__WARP_FRAC_BITS;
     const int32_t y_max = (int32_t)(h - 1) << HOME__WARP_FRAC_BITS;
-    const int64_t x1 = (int64_t)x0 + (int64_t)dx * (n - 1), y1 = (int64_t)y0 + (int64_t)dy * (n - 1);
+    const int64_t x1 = (int64_t)x0 + (int64_t)dx * (n - 1),
+                  y1 = (int64_t)y0 + (int64_t)dy * (n - 1);
     /* affine: the row's extremes are its ends */
     return n > 0 && x0 >= 0 && x0 < x_max && x1 >= 0 && x1 < x_max && y0 >= 0 && y0 < y_max &&
            y1 >= 0 && y1 < y_max;

@@ -11,13 +11,15 @@
 static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0, int32_t y0,
                          int32_t dx, int32_t dy, uint8_t *dst, int n)
 {
-    const __m128i step_x = _mm_set1_epi16(home__stab_low16(0, dx, 8)), step_y = _mm_set1_epi16(home__stab_low16(0, dy, 8));
+    const __m128i step_x = _mm_set1_epi16(home__stab_low16(0, dx, 8)),
+                  step_y = _mm_set1_epi16(home__stab_low16(0, dy, 8));
     const __m128i step8 = _mm_set1_epi32(home__stab_wrap32(0, dx, 8));
     const uint32_t dy7 = 7u * (uint32_t)dy, dy8 = 8u * (uint32_t)dy;
     __m128i frac_x, frac_y, xa, xb, top, bot;
     const uint8_t *row;
     uint8_t *d = dst, *const end = dst + n;
-    uint32_t lo, yrel;   /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
+    /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
+    uint32_t lo, yrel;
     (void)w; /* per-pixel loads: the row's width does not matter */
     {
         /* k dq & 0xffff = k (dq & 0xffff) & 0xffff: the fractions of pixels k = 0..7 are the
@@ -39,7 +41,8 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0
             home__stab_gather8(row, stride, xa, xb, &top, &bot);
         } else {   /* the group crosses a source row, here or before it: each pixel's own rows */
             const uint32_t y = lo + yrel - dy7, next = y + dy8;
-            home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)y, dx, dy, &top, &bot);
+            home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)y, dx,
+                                    dy, &top, &bot);
             if (d + 8 < end) {   /* next is a pixel of the row: inside; track its row */
                 lo = next & ~0xffffu;
                 yrel = y + dy7 - lo;   /* next + dy7 - lo after the step below */
@@ -56,7 +59,9 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0
     }
 }
 
-const home__stab_kernels home__stab_kernels_sse = {.name = "sse", .block = 8, .warp_row = warp_row_sse};
+const home__stab_kernels home__stab_kernels_sse = { .name = "sse",
+                                                    .block = 8,
+                                                    .warp_row = warp_row_sse };
 #else
 typedef int home__stab_sse_unused; /* ISO C forbids an empty translation unit */
 #endif

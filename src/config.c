@@ -9,7 +9,8 @@ const char *home_strerror(int status)
     switch (status) {
     case HOME_OK: return "success";
     case HOME_E_NULL: return "a required pointer argument is NULL";
-    case HOME_E_SIZE: return "image size out of range (each side must be in [HOME_MIN_SIDE, HOME_MAX_SIDE])";
+    case HOME_E_SIZE:
+        return "image size out of range (each side must be in [HOME_MIN_SIDE, HOME_MAX_SIDE])";
     case HOME_E_STRIDE: return "row stride is smaller than the image width";
     case HOME_E_CONFIG: return "a configuration value is out of range, NaN or infinite";
     case HOME_E_ARENA_SMALL: return "arena is smaller than home_arena_size() requires";
@@ -64,7 +65,8 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->r_step = 1.0f;
     cfg->r_bins = 0;
     cfg->smooth_sigma = 1.3f;
-    cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 1000 ? HOME_MAX_KEYPOINTS_PER_SIGN : 1000;
+    cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 1000 ? HOME_MAX_KEYPOINTS_PER_SIGN
+                                                                 : 1000;
     cfg->ratio = 0.9f;
     cfg->threshold_start = 64.0f;
     cfg->threshold_final = 1.0f;
@@ -112,7 +114,8 @@ int home_video_config(home_config *cfg, int width, int height)
  * the mirror i -> r_bins-1-i. */
 static int r_bins_for(int width, int height, float r_step)
 {
-    double half_diag = 0.5 * sqrt((double)(width - 1) * (width - 1) + (double)(height - 1) * (height - 1));
+    double half_diag =
+        0.5 * sqrt((double)(width - 1) * (width - 1) + (double)(height - 1) * (height - 1));
     return 2 * ((int)ceil(half_diag / r_step) + 1);
 }
 
@@ -149,7 +152,8 @@ int home_validate_config(const home_config *cfg)
             cfg->r_bins > 4 * HOME_MAX_SIDE)
             return HOME_E_CONFIG;
     }
-    if (!home__finite_in(cfg->smooth_sigma, 0.3f, HOME__MAX_SMOOTH_RADIUS / 3.0f)) return HOME_E_CONFIG;
+    if (!home__finite_in(cfg->smooth_sigma, 0.3f, HOME__MAX_SMOOTH_RADIUS / 3.0f))
+        return HOME_E_CONFIG;
     if (cfg->keypoints_per_sign < 8 || cfg->keypoints_per_sign > HOME_MAX_KEYPOINTS_PER_SIGN)
         return HOME_E_CONFIG;
     if (!home__finite_in(cfg->ratio, 0.1f, 1.0f)) return HOME_E_CONFIG;
@@ -164,10 +168,10 @@ int home_validate_config(const home_config *cfg)
     if (!home__kernels_for(cfg->simd)) return HOME_E_CONFIG; /* unknown or not compiled in */
     if (cfg->hough_method != HOME_HOUGH_FAST && cfg->hough_method != HOME_HOUGH_EXACT)
         return HOME_E_CONFIG;
-    if (cfg->hough_downscale != 1 &&
-        ((cfg->hough_downscale != 2 && cfg->hough_downscale != 4) ||
-         cfg->hough_method != HOME_HOUGH_FAST || cfg->width / cfg->hough_downscale < HOME_MIN_SIDE ||
-         cfg->height / cfg->hough_downscale < HOME_MIN_SIDE))
+    if (cfg->hough_downscale != 1 && ((cfg->hough_downscale != 2 && cfg->hough_downscale != 4) ||
+                                      cfg->hough_method != HOME_HOUGH_FAST ||
+                                      cfg->width / cfg->hough_downscale < HOME_MIN_SIDE ||
+                                      cfg->height / cfg->hough_downscale < HOME_MIN_SIDE))
         return HOME_E_CONFIG;
     if (cfg->match_theta_window < 0 || cfg->match_theta_window > cfg->theta_bins)
         return HOME_E_CONFIG;

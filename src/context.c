@@ -18,7 +18,8 @@ static void plan(const home_config *cfg, layout *l)
     l->ctx = home__take(&cur, sizeof(home_context));
     l->hough = home__take(&cur, home__hough_bytes(cfg));
     l->heap = home__take(&cur, 2 * (size_t)cfg->keypoints_per_sign * sizeof(home__candidate));
-    l->heap_entries = home__take(&cur, 2 * (size_t)cfg->keypoints_per_sign * sizeof(home__heap_entry));
+    l->heap_entries = home__take(&cur,
+                                 2 * (size_t)cfg->keypoints_per_sign * sizeof(home__heap_entry));
     l->extrema = home__take(&cur, r_bins * sizeof(home__extremum));
     l->candidates = home__take(&cur, r_bins * sizeof(int));
     l->matches = home__take(&cur, (size_t)l->max_matches * sizeof(home__match));

@@ -95,7 +95,8 @@ struct home_context {
     float smooth_taps[2 * HOME__MAX_SMOOTH_RADIUS + 1];
     const home__kernels *kernels;     /* SIMD backend */
     /* arena-backed buffers */
-    int16_t *grad_x, *grad_y;         /* EXACT: width x height central differences, 0 on the border */
+    /* EXACT: width x height central differences, 0 on the border */
+    int16_t *grad_x, *grad_y;
     uint8_t *img_n, *img_t;           /* FAST: the image and its transpose, zero-padded by
                                          HOME__RADON_BLOCK columns on each side */
     ptrdiff_t img_n_stride, img_t_stride;
@@ -188,7 +189,8 @@ void home__smooth_theta(const home__kernels *kernels, const float *const *rows, 
                         const float *taps, int radius);
 
 /* extrema.c */
-void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool, int capacity);
+void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool,
+                     int capacity);
 int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t order);
 void home__heap_push(home__heap *heap, const home__candidate *cand);
 /* Sorts the entries, most salient first; the i-th is then &pool[entries[i].slot]. Returns the

@@ -55,7 +55,8 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
         uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
         memset(row, 0, (size_t)pad);
         if (ds > 1)
-            ctx->kernels->box_down(image + (ptrdiff_t)(ds * y) * stride, stride, ds, row + pad, width);
+            ctx->kernels->box_down(image + (ptrdiff_t)(ds * y) * stride, stride, ds, row + pad,
+                                   width);
         else
             memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
         memset(row + pad + width, 0, (size_t)pad);
@@ -76,8 +77,8 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
 /* The image a theta family reads, in processing order: its column 0 of row 0, the row step,
  * rows and columns. vertical: lines within 45 degrees of the columns (the image itself), else
  * the transposed image; flip: rows taken bottom to top. */
-static const uint8_t *family_image(const home_context *ctx, int vertical, int flip, ptrdiff_t *stride,
-                                   int *rows, int *cols)
+static const uint8_t *family_image(const home_context *ctx, int vertical, int flip,
+                                   ptrdiff_t *stride, int *rows, int *cols)
 {
     const ptrdiff_t img_stride = vertical ? ctx->img_n_stride : ctx->img_t_stride;
     const uint8_t *img = (vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK;
@@ -181,7 +182,8 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
     g->end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
     {
         /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0; the
-         * bins with jf in [0, n - 1) are a contiguous range (jf is monotonic in i), zero elsewhere */
+         * bins with jf in [0, n - 1) are a contiguous range (jf is monotonic in i), zero elsewhere
+         */
         const double dj = ctx->cfg.r_step / a;
         const double jf0 = -0.5 * (ctx->r_bins - 1) * dj + 0.5 * (cols - 1) - j0;
         const double last = (double)(n - 1);
@@ -301,9 +303,11 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
 
         j = k - radius; /* the theta-smoothed row now complete */
         for (i = 0; i < raw_ring; i++)
-            raw_window[i] = ctx->raw_rows + (size_t)((j - radius + i - first_raw) % raw_ring) * r_bins;
+            raw_window[i] = ctx->raw_rows +
+                            (size_t)((j - radius + i - first_raw) % raw_ring) * r_bins;
         home__smooth_theta(ctx->kernels, raw_window,
-                           ctx->smooth_rows + (size_t)((j - first_smooth) % HOME__DESC_ROWS) * r_bins,
+                           ctx->smooth_rows +
+                               (size_t)((j - first_smooth) % HOME__DESC_ROWS) * r_bins,
                            r_bins, ctx->smooth_taps, radius);
         for (i = 0; i < HOME__DESC_ROWS; i++) {
             int row = j - (HOME__DESC_ROWS - 1) + i;
@@ -341,7 +345,8 @@ static size_t geom_record_bytes(int longest, int blocks, size_t intercepts, size
            2 * home__align_up((size_t)blocks * sizeof(int16_t), 16) +
            home__align_up(((size_t)longest + 4) * sizeof(int32_t), 16) +
            2 * home__align_up(intercepts * sizeof(int16_t), 16) +
-           home__align_up(r_bins * sizeof(int16_t), 16) + home__align_up(r_bins * sizeof(float), 16);
+           home__align_up(r_bins * sizeof(int16_t), 16) +
+           home__align_up(r_bins * sizeof(float), 16);
 }
 
 /* Point a record's arrays into mem (geom_record_bytes of it). */
@@ -393,9 +398,11 @@ static void hough_plan(const home_config *cfg, hough_layout *l)
         l->geom_longest = (int)longest;
         l->geom_blocks = (int)(intercepts / HOME__RADON_BLOCK + 1);
         l->geom_intercepts = w + h + 8;
-        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, l->geom_intercepts, r_bins);
+        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, l->geom_intercepts,
+                                          r_bins);
         home__hough_raw_rows(cfg, (int)radius, &l->geom_first, &rows);
-        bytes = home__align_up((size_t)rows * sizeof(home__theta_geom), 16) + (size_t)rows * l->geom_bytes;
+        bytes = home__align_up((size_t)rows * sizeof(home__theta_geom), 16) +
+                (size_t)rows * l->geom_bytes;
         if (bytes <= HOME_HOUGH_GEOMETRY_BYTES) {
             l->geom_rows = rows;
             l->geom = home__take(&cur, bytes);
@@ -437,8 +444,8 @@ void home__hough_init(home_context *ctx, unsigned char *block)
         ctx->img_t_stride = l.img_t_stride;
         if (l.geom_rows) {
             /* records first, then their arrays; every row's geometry computed once, here */
-            unsigned char *arrays = block + l.geom +
-                                    home__align_up((size_t)l.geom_rows * sizeof(home__theta_geom), 16);
+            unsigned char *arrays =
+                block + l.geom + home__align_up((size_t)l.geom_rows * sizeof(home__theta_geom), 16);
             int k;
             ctx->geom = (home__theta_geom *)(void *)(block + l.geom);
             for (k = 0; k < l.geom_rows; k++) {

@@ -94,9 +94,10 @@ void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t s
     body = n - n % k->block;
     if (body > 0) k->warp_row(src, stride, w, x0, y0, dx, dy, dst, body);
     if (body < n) /* inside too: the reference's fast path */
-        home__warp_row_c(src, stride, 1, w, h, (int32_t)((uint32_t)x0 + (uint32_t)body * (uint32_t)dx),
-                         (int32_t)((uint32_t)y0 + (uint32_t)body * (uint32_t)dy), dx, dy, dst + body,
-                         1, n - body);
+        home__warp_row_c(src, stride, 1, w, h,
+                         (int32_t)((uint32_t)x0 + (uint32_t)body * (uint32_t)dx),
+                         (int32_t)((uint32_t)y0 + (uint32_t)body * (uint32_t)dy), dx, dy,
+                         dst + body, 1, n - body);
 }
 
 static int32_t to_q16(double v) { return (int32_t)floor(v * 65536.0 + 0.5); }
@@ -106,7 +107,8 @@ int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image 
     return home_stab_warp_rows(m, src, dst, 0, dst ? dst->height : 0);
 }
 
-int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_image *dst, int first_row, int rows)
+int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_image *dst,
+                        int first_row, int rows)
 {
     plane_view views[3];
     const home__stab_kernels *kern;
@@ -120,7 +122,8 @@ int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_i
         return HOME_E_MISMATCH;
     /* a band of whole chroma rows: with vertically subsampled chroma it starts and ends even */
     if (first_row < 0 || rows < 1 || rows > dst->height - first_row) return HOME_E_CONFIG;
-    if ((dst->format == HOME_STAB_I420 || dst->format == HOME_STAB_NV12) && (first_row % 2 || rows % 2))
+    if ((dst->format == HOME_STAB_I420 || dst->format == HOME_STAB_NV12) &&
+        (first_row % 2 || rows % 2))
         return HOME_E_CONFIG;
     for (k = 0; k < 9; k++)
         if (!isfinite(m[k])) return HOME_E_CONFIG;
