@@ -111,7 +111,8 @@ typedef struct home_config {
                                  (4096): fewer cost proportionally less per iteration */
     int refine_finest_level;  /* pyramid level the refinement ends at: 0 = full resolution
                                  (default); 1 = half: no full-size point selection or
-                                 iterations (~2x faster refinement, about twice the error) */
+                                 iterations (a faster refinement, a larger error; see
+                                 docs/presets.md) */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
     int hough_downscale;      /* 1: Hough transform of the image itself; 2 or 4: of its 2x2- or
@@ -136,7 +137,7 @@ int home_default_config(home_config *cfg, int width, int height);
  * features): the Hough transform of a box-downscaled frame about 160 px wide with 120 theta
  * bins, 500 keypoints per sign, an 8-bin (12 degree) theta window, a first threshold of 8;
  * the photometric refinement (2048 template points, ending at half resolution:
- * refine_finest_level 1; set it to 0 for full resolution at ~30 % more time) restores
+ * refine_finest_level 1; set it to 0 for full resolution at more cost) restores
  * sub-pixel precision. Motion between
  * the frames should stay under ~30 px at the corners (README, Speed). */
 int home_video_config(home_config *cfg, int width, int height);

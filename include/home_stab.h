@@ -77,9 +77,8 @@ typedef struct home_stab_config {
                                  refine_levels default), 0: off */
     int refine_finest_level;  /* HOME's refine_finest_level (see home_config): 0 = the
                                  refinement ends at the registration image's full size, 1 = at
-                                 half size (the default: on the bench clips jitter within
-                                 0.005 px, ITF within 0.01 dB of full size, for 22 % fewer
-                                 instructions per frame, see bench/stab) */
+                                 half size (the default: as steady as full size for less work;
+                                 docs/presets.md) */
     int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
                                  2x2- or 4x4-box downscaled copy (2, 4), see home_config; 0 =
                                  automatic (home_video_config's: a copy about 160 px wide) */

@@ -29,7 +29,7 @@ bench-refine: $(REFINE_BENCH)
 # Evaluation against ORB, AKAZE and LSD/LBD on real photographs (bench/eval, Python 3).
 #   make eval        full run: regenerates bench/eval/results.md and its plots
 #   make eval-quick  the CI subset: report in $(EVAL_CACHE)/quick/results.md
-#   make eval-trust        issue 16: can `ok` be trusted? tuning set vs test set, still
+#   make eval-trust        can `ok` be trusted (docs/trust.md)? tuning set vs test set, still
 #                          pairs, consecutive frames, static camera, and the sealed set's
 #                          static clips; rewrites bench/eval/trust_results.md,
 #                          trust_results.json.gz and trust_*.png

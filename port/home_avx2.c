@@ -1,7 +1,5 @@
-/* AVX2 kernels (x86-64 CPUs that report AVX2; compiled with -mavx2): the Radon accumulation and
- * the Gaussian smoothing of the Hough image gained from wider vectors, as did the refinement's
- * blur and keys (port/refine_avx2.c) and the stabiliser's warp (port/stab_avx2.c); the other
- * kernels of this table are the SSE2 ones. */
+/* AVX2 kernels (x86-64 CPUs that report AVX2; compiled with -mavx2): those that are worth 256-bit
+ * vectors (docs/simd.md); the other entries of this table are the SSE2 kernels. */
 #include "kernels.h"
 #if defined(HOME__HAVE_AVX2) && defined(__AVX2__)
 #include <immintrin.h>

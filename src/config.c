@@ -91,21 +91,17 @@ int home_video_config(home_config *cfg, int width, int height)
     /* the largest box that leaves the Hough image at least 160 px wide */
     cfg->hough_downscale = width >= 640 && height >= 4 * HOME_MIN_SIDE ? 4
                          : width >= 320 && height >= 2 * HOME_MIN_SIDE ? 2 : 1;
-    /* ~2.4 px of the Hough image at its rim: on the video set (bench/eval) 120, 160, 240 and
-     * 480 bins give the same errors once refined (120: 0.15 / 0.14 / 0.17 / 0.33 px); still
-     * pairs at p = 40 / 50 / 60 fail 0 / 6 / 17 % (160 bins: 1 / 4 / 17 %); 11 % fewer
-     * instructions per frame than 160 */
+    /* ~2.4 px of the Hough image at its rim: once refined as precise as more bins, and cheaper
+     * (docs/presets.md) */
     cfg->theta_bins = 120;
     cfg->wrap_band = 7;           /* ~10 degrees, like the defaults' 27 of 480 */
     cfg->keypoints_per_sign = HOME_MAX_KEYPOINTS_PER_SIGN < 500 ? HOME_MAX_KEYPOINTS_PER_SIGN : 500;
     cfg->match_theta_window = 8;  /* 12 degrees of roll between frames */
     cfg->threshold_start = 8.0f;
-    /* half the refinement's points: on the video set the same errors to 0.01 px (0.15 / 0.14 /
-     * 0.17 / 0.35 against 0.14 / 0.14 / 0.17 / 0.34), 15 % fewer instructions per frame */
+    /* half the refinement's points: the same errors, less work (docs/presets.md) */
     cfg->refine_points = HOME_REFINE_MAX_POINTS < 2048 ? HOME_REFINE_MAX_POINTS : 2048;
-    /* the refinement ends at half size: on the video set 0.18 / 0.16 / 0.21 / 0.25 px against
-     * 0.15 / 0.14 / 0.17 / 0.33 at full size, ~30 % fewer instructions per frame (no full-size
-     * blur, point selection or iterations) and ~250 KB less arena at 640x360 */
+    /* the refinement ends at half size: no full-size blur, point selection or iterations, and
+     * a smaller arena, for slightly larger errors (docs/presets.md) */
     cfg->refine_finest_level = cfg->refine_levels > 1 ? 1 : 0;
     return HOME_OK;
 }

@@ -24,7 +24,7 @@ static int check_ctx(const home_context *ctx)
 
 /* Four partial sums (element i in lane i % 4), added (0 + 1) + (2 + 3) at the end: a fixed order
  * on every target, and four independent chains instead of one (a single running sum waits on
- * each addition: ~5 % of a video frame's time). */
+ * each addition; docs/simd.md). */
 static void accumulate_stats(extract_state *st, const float *row, int n)
 {
     double s[4] = {0.0, 0.0, 0.0, 0.0}, s2[4] = {0.0, 0.0, 0.0, 0.0};
