@@ -2,6 +2,8 @@
  * vectors (docs/simd.md); the other entries of this table are the SSE2 kernels. */
 #include "kernels.h"
 #if defined(HOME__HAVE_AVX2) && defined(__AVX2__)
+#include "simd_f32x8.h"
+#include "home_fvec.h"
 #include <immintrin.h>
 
 /* 64 lanes as 4 x 16 uint16 (vpmovzxbw widens 16 pixels per load); into int32 every 128 rows */
@@ -44,107 +46,6 @@ static void radon_blocks_avx2(const uint8_t *base, ptrdiff_t stride, const int16
             }
         }
     }
-}
-
-/* Same multiply-then-add order as the scalar reference (no FMA), 8 outputs at a time:
- * bit-identical. Body only: the callers finish the tails. */
-/* The taps in the reference's order (k = 0 .. 2 radius), one product and one sum each. With the
- * default radius 4 (sigma 1.3) the nine broadcast taps stay in registers, unrolled; other radii
- * take the generic loop. */
-#define SMOOTH_TAP(k, src) acc = _mm256_add_ps(acc, _mm256_mul_ps(t##k, _mm256_loadu_ps(src)))
-
-static int smooth_row_avx2(const float *in, float *out, int n, const float *taps, int radius)
-{
-    int i = radius, k;
-    if (radius == 4) {
-        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]),
-                     t2 = _mm256_set1_ps(taps[2]), t3 = _mm256_set1_ps(taps[3]),
-                     t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
-                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]),
-                     t8 = _mm256_set1_ps(taps[8]);
-        for (; i + 8 <= n - radius; i += 8) {
-            const float *p = in + i - 4;
-            __m256 acc = _mm256_setzero_ps();
-            SMOOTH_TAP(0, p); SMOOTH_TAP(1, p + 1); SMOOTH_TAP(2, p + 2); SMOOTH_TAP(3, p + 3);
-            SMOOTH_TAP(4, p + 4); SMOOTH_TAP(5, p + 5); SMOOTH_TAP(6, p + 6); SMOOTH_TAP(7, p + 7);
-            SMOOTH_TAP(8, p + 8);
-            _mm256_storeu_ps(out + i, acc);
-        }
-    }
-    for (; i + 8 <= n - radius; i += 8) {
-        __m256 acc = _mm256_setzero_ps();
-        for (k = 0; k <= 2 * radius; k++)
-            acc = _mm256_add_ps(
-                acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(in + i - radius + k)));
-        _mm256_storeu_ps(out + i, acc);
-    }
-    return i;
-}
-
-static int smooth_cols_avx2(const float *const *rows, float *out, int n, const float *taps,
-                            int radius)
-{
-    int i = 0, k;
-    if (radius == 4) {
-        const __m256 t0 = _mm256_set1_ps(taps[0]), t1 = _mm256_set1_ps(taps[1]),
-                     t2 = _mm256_set1_ps(taps[2]), t3 = _mm256_set1_ps(taps[3]),
-                     t4 = _mm256_set1_ps(taps[4]), t5 = _mm256_set1_ps(taps[5]),
-                     t6 = _mm256_set1_ps(taps[6]), t7 = _mm256_set1_ps(taps[7]),
-                     t8 = _mm256_set1_ps(taps[8]);
-        const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4],
-                    *r5 = rows[5], *r6 = rows[6], *r7 = rows[7], *r8 = rows[8];
-        for (; i + 8 <= n; i += 8) {
-            __m256 acc = _mm256_setzero_ps();
-            SMOOTH_TAP(0, r0 + i);
-            SMOOTH_TAP(1, r1 + i);
-            SMOOTH_TAP(2, r2 + i);
-            SMOOTH_TAP(3, r3 + i);
-            SMOOTH_TAP(4, r4 + i);
-            SMOOTH_TAP(5, r5 + i);
-            SMOOTH_TAP(6, r6 + i);
-            SMOOTH_TAP(7, r7 + i);
-            SMOOTH_TAP(8, r8 + i);
-            _mm256_storeu_ps(out + i, acc);
-        }
-    }
-    for (; i + 8 <= n; i += 8) {
-        __m256 acc = _mm256_setzero_ps();
-        for (k = 0; k <= 2 * radius; k++)
-            acc = _mm256_add_ps(
-                acc, _mm256_mul_ps(_mm256_set1_ps(taps[k]), _mm256_loadu_ps(rows[k] + i)));
-        _mm256_storeu_ps(out + i, acc);
-    }
-    return i;
-}
-#undef SMOOTH_TAP
-
-/* The SSE2 kernel's test on eight bins per step. */
-static int extremum_candidates_avx2(const float *up, const float *mid, const float *down, int n,
-                                    int *idx, int *end)
-{
-    const __m256 zero = _mm256_setzero_ps();
-    int i, count = 0;
-    for (i = 1; i + 8 <= n - 1; i += 8) {
-        __m256 v = _mm256_loadu_ps(mid + i);
-        __m256 a = _mm256_loadu_ps(up + i - 1), b = _mm256_loadu_ps(up + i),
-               c = _mm256_loadu_ps(up + i + 1);
-        __m256 d = _mm256_loadu_ps(mid + i - 1), e = _mm256_loadu_ps(mid + i + 1);
-        __m256 f = _mm256_loadu_ps(down + i - 1), g = _mm256_loadu_ps(down + i),
-               h = _mm256_loadu_ps(down + i + 1);
-        __m256 hi = _mm256_max_ps(_mm256_max_ps(_mm256_max_ps(a, b), _mm256_max_ps(c, d)),
-                                  _mm256_max_ps(_mm256_max_ps(e, f), _mm256_max_ps(g, h)));
-        __m256 lo = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(a, b), _mm256_min_ps(c, d)),
-                                  _mm256_min_ps(_mm256_min_ps(e, f), _mm256_min_ps(g, h)));
-        __m256 pos = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ),
-                                   _mm256_cmp_ps(v, hi, _CMP_GT_OQ));
-        __m256 neg = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_LT_OQ),
-                                   _mm256_cmp_ps(v, lo, _CMP_LT_OQ));
-        int mask = _mm256_movemask_ps(_mm256_or_ps(pos, neg)), lane;
-        for (lane = 0; mask; lane++, mask >>= 1)
-            if (mask & 1) idx[count++] = i + lane;
-    }
-    *end = i;
-    return count;
 }
 
 /* Eight lines per step; every table lookup is a gather. Lines that never enter the image
@@ -257,10 +158,10 @@ const home__kernels home__kernels_avx2 = {
     .name = "avx2",
     .radon_blocks = radon_blocks_avx2,
     .nearest2_l1 = home__nearest2_l1_sse,
-    .smooth_row = smooth_row_avx2,
-    .smooth_cols = smooth_cols_avx2,
+    .smooth_row = smooth_row_fv,
+    .smooth_cols = smooth_cols_fv,
     .box_down = box_down_avx2,
-    .extremum_candidates = extremum_candidates_avx2,
+    .extremum_candidates = extremum_candidates_fv,
     .line_ends = line_ends_avx2,
     .resample = resample_avx2,
     .line_fit = &home__line_fit_avx2,

@@ -1,7 +1,8 @@
 /* NEON kernels (aarch64, and armv7 built with -mfpu=neon). */
 #include "kernels.h"
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
-#include "home_f32x4.h"
+#include "simd_f32x4.h"
+#include "home_fvec.h"
 #include <arm_neon.h>
 
 /* 64 lanes held as 8 x 8 uint16 in registers (vaddw_u8 widens while adding); widened into
@@ -84,10 +85,10 @@ const home__kernels home__kernels_neon = {
     .name = "neon",
     .radon_blocks = radon_blocks_neon,
     .nearest2_l1 = nearest2_l1_neon,
-    .smooth_row = smooth_row_f4,
-    .smooth_cols = smooth_cols_f4,
+    .smooth_row = smooth_row_fv,
+    .smooth_cols = smooth_cols_fv,
     .box_down = box_down_neon,
-    .extremum_candidates = extremum_candidates_f4,
+    .extremum_candidates = extremum_candidates_fv,
     .line_ends = home__line_ends_scalar,
     .resample = home__resample_scalar,
     .line_fit = &home__line_fit_scalar,

@@ -1,7 +1,8 @@
 /* SSE2 kernels (x86-64 baseline). */
 #include "kernels.h"
 #if defined(__SSE2__)
-#include "home_f32x4.h"
+#include "simd_f32x4.h"
+#include "home_fvec.h"
 #include <emmintrin.h>
 
 /* 64 lanes held as 8 x 8 uint16 in registers; widened into int32 every 128 rows. */
@@ -98,10 +99,10 @@ const home__kernels home__kernels_sse = {
     .name = "sse",
     .radon_blocks = radon_blocks_sse,
     .nearest2_l1 = home__nearest2_l1_sse,
-    .smooth_row = smooth_row_f4,
-    .smooth_cols = smooth_cols_f4,
+    .smooth_row = smooth_row_fv,
+    .smooth_cols = smooth_cols_fv,
     .box_down = home__box_down_sse,
-    .extremum_candidates = extremum_candidates_f4,
+    .extremum_candidates = extremum_candidates_fv,
     .line_ends = home__line_ends_scalar,
     .resample = home__resample_scalar,
     .line_fit = &home__line_fit_scalar,

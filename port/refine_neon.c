@@ -4,8 +4,8 @@
 #include "refine_kernels.h"
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #include <arm_neon.h>
-#define F4_NAME(name) name##_neon
-#define F4_LINKAGE static
+#define FV_NAME(name) name##_neon
+#define FV_LINKAGE static
 #include "refine_f32x4.h"
 
 static void blur3_neon(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,

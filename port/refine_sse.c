@@ -3,8 +3,8 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #include <string.h>
-#define F4_NAME(name) home__refine_##name##_sse /* the AVX2 table shares them */
-#define F4_LINKAGE
+#define FV_NAME(name) home__refine_##name##_sse /* the AVX2 table shares them */
+#define FV_LINKAGE
 #include "refine_f32x4.h"
 
 static __m128i load8_u16(const uint8_t *p)
