@@ -86,7 +86,8 @@ typedef struct home_stab_config {
                                  home_video_config's 120: the refinement gives the precision);
                                  fewer suit tiny frames */
     int simd;                 /* enum home_simd for HOME (default AUTO: the HOME_SIMD env or the
-                                 best compiled in; the warp always takes AUTO's) */
+                                 best compiled in); the warp takes the best this CPU has (all
+                                 backends give the same bytes) */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
     float max_rotation;       /* plausible per-frame rotation, radians */
     float max_zoom;           /* plausible per-frame |log scale| */

@@ -30,6 +30,7 @@ static int best_simd(void)
 
 int home__simd_resolve(int simd)
 {
+    if (simd == HOME__SIMD_BEST) return best_simd();
 #ifndef HOME_NO_GETENV
     if (simd == HOME_SIMD_AUTO) {
         const char *env = getenv("HOME_SIMD");

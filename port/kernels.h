@@ -3,6 +3,7 @@
  * which tests/test_backends.c checks on odd sizes, unaligned pointers and extreme inputs. */
 #ifndef HOME_KERNELS_H
 #define HOME_KERNELS_H
+#include "dispatch.h"
 #include "line_fit_kernels.h"
 #include <stddef.h>
 #include <stdint.h>
@@ -143,11 +144,6 @@ extern const home__kernels home__kernels_avx2;
 extern const home__kernels home__kernels_neon;
 #endif
 
-/* The one SIMD resolver (port/dispatch.c): the backend a home_simd request runs on. AUTO becomes
- * the HOME_SIMD environment variable's choice when set (none, sse, avx2 or neon; not read when
- * built with -DHOME_NO_GETENV), else the best this build and CPU have. Returns -1 when the
- * request names a backend this build or CPU lacks. Every table lookup goes through it. */
-int home__simd_resolve(int simd);
 
 /* The table for a home_simd value, or NULL when home__simd_resolve() refuses it. */
 const home__kernels *home__kernels_for(int simd);

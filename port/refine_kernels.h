@@ -5,6 +5,7 @@
  * tests/test_backends.c checks on odd sizes and unaligned pointers. */
 #ifndef HOME_REFINE_KERNELS_H
 #define HOME_REFINE_KERNELS_H
+#include "dispatch.h"
 #include <stddef.h>
 #include <stdint.h>
 

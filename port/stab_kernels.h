@@ -3,6 +3,7 @@
  * which tests/test_backends.c checks on odd widths, unaligned pointers and clamped rows. */
 #ifndef HOME_STAB_KERNELS_H
 #define HOME_STAB_KERNELS_H
+#include "dispatch.h"
 #include <stddef.h>
 #include <stdint.h>
 

@@ -138,8 +138,9 @@ int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_i
         if (u < -limit_x + src->width || u > limit_x || v < -limit_y + src->height || v > limit_y)
             return HOME_E_CONFIG;
     }
-    /* the resolver's backend (port/dispatch.c); all give the same bytes */
-    kern = home__stab_kernels_for(HOME_SIMD_AUTO);
+    /* the best backend here (port/dispatch.c; CPU detection, no getenv per band): all give the
+     * same bytes, which tests/test_backends.c checks for every backend */
+    kern = home__stab_kernels_for(HOME__SIMD_BEST);
     if (!kern) kern = &home__stab_kernels_scalar;
     n = plane_views(src, dst, views);
     for (k = 0; k < n; k++) {
