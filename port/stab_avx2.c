@@ -117,9 +117,7 @@ static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
         if (x + dx8 < xlim) fast = dx16 ? (xlim - 1 - x - dx8) / dx16 + 1 : groups;
         fast_end = dst + 16 * (ptrdiff_t)(fast < groups ? fast : groups);
     }
-    lo = (uint32_t)y0 & ~0xffffu;
-    yrel = (uint32_t)y0 + dy15 - lo;
-    row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
+    row = home__stab_track_row(src, stride, (uint32_t)y0, dy15, &lo, &yrel);
     while (d < end) {
         if (d < fast_end && yrel < 0x10000u) {
             /* affine: a group's first pixel is on the tracked row when the previous group's last
@@ -167,9 +165,7 @@ static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
             const uint32_t y = lo + yrel - dy15, next = y + dy16;
             /* the row was crossed before this group: track the new one */
             if ((y & ~0xffffu) != lo) {
-                lo = y & ~0xffffu;
-                yrel = y + dy15 - lo;
-                row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+                row = home__stab_track_row(src, stride, y, dy15, &lo, &yrel);
                 continue;
             }
             if (d < fast_end && cross) {
@@ -200,9 +196,7 @@ static void warp_row_avx2(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
             x += dx16;
             d += 16;
             if (d < end) {   /* next is a pixel of the row: inside; track its row */
-                lo = next & ~0xffffu;
-                yrel = next + dy15 - lo;
-                row = src + (ptrdiff_t)(next >> HOME__WARP_FRAC_BITS) * stride;
+                row = home__stab_track_row(src, stride, next, dy15, &lo, &yrel);
             }
         }
     }

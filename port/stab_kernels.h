@@ -29,6 +29,18 @@ void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int
 typedef void (*home__warp_row_fn)(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0,
                                   int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int n);
 
+/* The SIMD warp bodies follow the source row pair their groups of pixels sit on: for a group
+ * whose first pixel is at Q16 y and whose last `span` further, *lo becomes the first Q16 y of y's
+ * source row and *yrel the last pixel's y less *lo (wrapping); returns the row's first byte. */
+static inline const uint8_t *home__stab_track_row(const uint8_t *src, ptrdiff_t stride,
+                                                  uint32_t y, uint32_t span, uint32_t *lo,
+                                                  uint32_t *yrel)
+{
+    *lo = y & ~0xffffu;
+    *yrel = y + span - *lo;
+    return src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+}
+
 typedef struct home__stab_kernels {
     const char *name;
     int block;                 /* output pixels per step of warp_row */

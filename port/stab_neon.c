@@ -114,9 +114,7 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
      * plus lanes k of these (wrapping like the Q16 sums) */
     frac_x = vaddq_u16(vdupq_n_u16((uint16_t)x0), edge);
     frac_y = vaddq_u16(vdupq_n_u16((uint16_t)y0), vmulq_n_u16(lane, (uint16_t)dy));
-    lo = (uint32_t)y0 & ~0xffffu;
-    yrel = (uint32_t)y0 + dy7 - lo;
-    row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
+    row = home__stab_track_row(src, stride, (uint32_t)y0, dy7, &lo, &yrel);
     while (d < end) {
         if (d < fast_end && yrel < 0x10000u) {
             /* affine: a group's first pixel is on the tracked row when the previous group's last
@@ -147,9 +145,7 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
             const uint32_t y = lo + yrel - dy7, next = y + dy8;
             /* the row was crossed before this group: track the new one */
             if ((y & ~0xffffu) != lo) {
-                lo = y & ~0xffffu;
-                yrel = y + dy7 - lo;
-                row = src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+                row = home__stab_track_row(src, stride, y, dy7, &lo, &yrel);
                 continue;
             }
             if (d < fast_end && cross) {
@@ -179,9 +175,7 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
             x += dx8;
             d += 8;
             if (d < end) {   /* next is a pixel of the row: inside; track its row */
-                lo = next & ~0xffffu;
-                yrel = next + dy7 - lo;
-                row = src + (ptrdiff_t)(next >> HOME__WARP_FRAC_BITS) * stride;
+                row = home__stab_track_row(src, stride, next, dy7, &lo, &yrel);
             }
         }
     }

@@ -31,9 +31,7 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0
                                _mm_mullo_epi16(_mm_set1_epi16(home__stab_low16(0, dy, 1)), lane));
     }
     home__stab_xs((uint32_t)x0, dx, &xa, &xb);
-    lo = (uint32_t)y0 & ~0xffffu;
-    yrel = (uint32_t)y0 + dy7 - lo;
-    row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
+    row = home__stab_track_row(src, stride, (uint32_t)y0, dy7, &lo, &yrel);
     while (d < end) {
         /* affine: a group's first pixel is on the tracked row when the previous group's last
          * was, so its last decides */
@@ -44,9 +42,8 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0
             home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)y, dx,
                                     dy, &top, &bot);
             if (d + 8 < end) {   /* next is a pixel of the row: inside; track its row */
-                lo = next & ~0xffffu;
-                yrel = y + dy7 - lo;   /* next + dy7 - lo after the step below */
-                row = src + (ptrdiff_t)(next >> HOME__WARP_FRAC_BITS) * stride;
+                /* yrel: next's (next + dy7 - lo) after the step below */
+                row = home__stab_track_row(src, stride, next, dy7 - dy8, &lo, &yrel);
             }
         }
         home__stab_blend8(top, bot, frac_x, frac_y, d);
