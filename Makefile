@@ -45,7 +45,7 @@ test: all
 	BUILD=$(BUILD) NM="$(NM)" OBJDUMP="$(OBJDUMP)" RUNNER="$(RUNNER)" CC="$(CC)" TEST_BINS="$(TEST_BINS)" SANFLAGS="$(if $(SANITIZE),-fsanitize=$(SANITIZE))" bash tests/run.sh
 
 golden: all
-	RUNNER="$(RUNNER)" bash tests/golden/golden.sh $(BUILD) --update
+	RUNNER="$(RUNNER)" GOLDEN_TARGET="$$($(CC) -dumpmachine)" bash tests/golden/golden.sh $(BUILD) --update
 
 # The stabilisation demo: a shaky clip of a structured, low-texture scene with known camera
 # motion, stabilised by home-stab (10 frames of lookahead); side-by-side Y4M (original |
