@@ -61,6 +61,8 @@ static void usage(FILE *f)
         "  --repeat N           register N times; ms are medians, plus \"frame\": one new frame\n"
         "                       registered against the previous one's cached features (the\n"
         "                       video case: B, A, B, ... alternately)\n"
+        "  --exact              every digit of H, sigma_px and the refinement's scores, no\n"
+        "                       timings (byte-comparable output)\n"
         "  --save-hough F.pgm   write A's quantised Hough image (rows theta, columns r) with\n"
         "                       its keypoints marked (white: J > 0, black: J < 0)\n"
         "  --help               this text\n",
@@ -145,7 +147,7 @@ int main(int argc, char **argv)
 {
     const char *paths[2] = {NULL, NULL}, *hough_path = NULL;
     home_config cfg;
-    int n_paths = 0, i, repeat = 1, status, s, video = 0;
+    int n_paths = 0, i, repeat = 1, status, s, video = 0, exact = 0;
     int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_rpoints = -1, opt_downscale = -1,
         opt_window = -1, opt_rfinest = -1, opt_max_model = -1;
     float opt_rtrust = -1, opt_max_sigma = -1;
@@ -168,6 +170,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
         if (!strcmp(a, "--no-refine")) { opt_rlevels = 0; continue; }
         if (!strcmp(a, "--video")) { video = 1; continue; }
+        if (!strcmp(a, "--exact")) { exact = 1; continue; }
         if (!strncmp(a, "--", 2) && !v) { fprintf(stderr, "home-register: %s needs a value\n", a); return 2; }
         if (!strcmp(a, "--keypoints")) bad = parse_int(v, &opt_kp), i++;
         else if (!strcmp(a, "--theta-bins")) bad = parse_int(v, &opt_theta), i++;
@@ -281,22 +284,28 @@ int main(int argc, char **argv)
     printf("{\"ok\":%s", res.ok ? "true" : "false");
     if (res.ok || res.failure != 0) {
         printf(",\"H\":[");
-        for (i = 0; i < 9; i++) printf("%s%.10g", i ? "," : "", res.H[i]);
+        for (i = 0; i < 9; i++) printf("%s%.*g", i ? "," : "", exact ? 17 : 10, res.H[i]);
         printf("]");
     }
     printf(",\"keypoints\":[%d,%d],\"matches\":%d,\"inliers\":%d,\"refined\":%s",
            res.keypoints_a, res.keypoints_b, res.matches, res.inliers,
            res.refined ? "true" : "false");
     printf(",\"model\":\"%s\",\"sigma_px\":", home_model_name(res.model));
-    if (isfinite(res.sigma_px)) printf("%.6g", res.sigma_px);
+    if (isfinite(res.sigma_px)) printf("%.*g", exact ? 17 : 6, res.sigma_px);
     else printf("null"); /* not determined: JSON has no infinity */
-    printf(",\"failure\":\"%s\",\"refine_status\":\"%s\",\"refine_zncc\":%.4f,"
-           "\"refine_inlier_share\":%.4f,\"ms\":{",
-           home_failure_name(res.failure), home_refine_status_name(res.refine_status),
-           res.refine_zncc, res.refine_inlier_share);
-    for (s = 0; s < HOME_STAGE_COUNT; s++) printf("%s\"%s\":%.3f", s ? "," : "", stage_names[s], ms[s]);
-    if (repeat > 1) printf(",\"frame\":%.3f", frame_ms);
-    printf("}}\n");
+    printf(",\"failure\":\"%s\",\"refine_status\":\"%s\"", home_failure_name(res.failure),
+           home_refine_status_name(res.refine_status));
+    if (exact) { /* every digit, no timings: byte-comparable output (tests/checks/golden.sh) */
+        printf(",\"refine_zncc\":%.17g,\"refine_inlier_share\":%.17g}\n", res.refine_zncc,
+               res.refine_inlier_share);
+    } else {
+        printf(",\"refine_zncc\":%.4f,\"refine_inlier_share\":%.4f,\"ms\":{", res.refine_zncc,
+               res.refine_inlier_share);
+        for (s = 0; s < HOME_STAGE_COUNT; s++)
+            printf("%s\"%s\":%.3f", s ? "," : "", stage_names[s], ms[s]);
+        if (repeat > 1) printf(",\"frame\":%.3f", frame_ms);
+        printf("}}\n");
+    }
     free(samples);
     free(arena_mem);
     free(buf_a);

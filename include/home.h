@@ -55,11 +55,17 @@ const char *home_strerror(int status);
 /* Optional timing hook: returns a monotonic time in milliseconds. The core has no OS clock. */
 typedef double (*home_clock_fn)(void *user);
 
-/* SIMD backend of a context. Every backend gives bit-identical results. home_default_config()
- * takes it from the environment variable HOME_SIMD=none|sse|avx2|neon when set (compile the
- * library with -DHOME_NO_GETENV for targets without an environment). AUTO picks NEON on ARM,
- * AVX2 on x86-64 CPUs that have it (SSE2 for everything but the Hough kernel), else SSE2. */
-enum home_simd { HOME_SIMD_AUTO = 0, HOME_SIMD_NONE, HOME_SIMD_SSE, HOME_SIMD_NEON, HOME_SIMD_AVX2 };
+/* SIMD backend of a context. Every backend gives bit-identical results. AUTO (the default)
+ * takes the environment variable HOME_SIMD=none|sse|avx2|neon when set (compile the library
+ * with -DHOME_NO_GETENV for targets without an environment), else picks NEON on ARM, AVX2 on
+ * x86-64 CPUs that have it (SSE2 for everything but the Hough kernel), else SSE2. */
+enum home_simd {
+    HOME_SIMD_AUTO = 0,
+    HOME_SIMD_NONE,
+    HOME_SIMD_SSE,
+    HOME_SIMD_NEON,
+    HOME_SIMD_AVX2
+};
 
 /* How J(theta, r) is computed. FAST: shear-and-add line sums of the image (one channel, exact
  * integer sums along nearest-pixel digital lines, SIMD), differentiated across lines with the
@@ -105,7 +111,8 @@ typedef struct home_config {
                                  (4096): fewer cost proportionally less per iteration */
     int refine_finest_level;  /* pyramid level the refinement ends at: 0 = full resolution
                                  (default); 1 = half: no full-size point selection or
-                                 iterations (~2x faster refinement, about twice the error) */
+                                 iterations (a faster refinement, a larger error; see
+                                 docs/presets.md) */
     int simd;                 /* enum home_simd */
     int hough_method;         /* enum home_hough_method */
     int hough_downscale;      /* 1: Hough transform of the image itself; 2 or 4: of its 2x2- or
@@ -130,7 +137,7 @@ int home_default_config(home_config *cfg, int width, int height);
  * features): the Hough transform of a box-downscaled frame about 160 px wide with 120 theta
  * bins, 500 keypoints per sign, an 8-bin (12 degree) theta window, a first threshold of 8;
  * the photometric refinement (2048 template points, ending at half resolution:
- * refine_finest_level 1; set it to 0 for full resolution at ~30 % more time) restores
+ * refine_finest_level 1; set it to 0 for full resolution at more cost) restores
  * sub-pixel precision. Motion between
  * the frames should stay under ~30 px at the corners (README, Speed). */
 int home_video_config(home_config *cfg, int width, int height);
@@ -141,7 +148,8 @@ int home_validate_config(const home_config *cfg);
 typedef struct home_context home_context;
 
 /* Name of the SIMD backend a context uses ("none", "sse", "avx2", "neon"); with ctx == NULL, the
- * backend HOME_SIMD_AUTO would pick in this build. */
+ * backend HOME_SIMD_AUTO would pick here ("unavailable" when HOME_SIMD names one this build or
+ * CPU lacks). */
 const char *home_simd_backend(const home_context *ctx);
 
 /* Exact bytes home_init() needs for cfg; 0 when cfg is invalid. */

@@ -41,8 +41,8 @@
 
 /* Arena bytes the fast Hough transform may spend on its theta geometry (row shears, block row
  * ranges, resampling weights) computed once per context instead of every frame: about 2 KB per
- * theta row for a 160 px wide Hough image (home_video_config at 640x360: 0.4 MB, ~5 % of a
- * frame's instructions). Contexts that need more compute it per frame. */
+ * theta row for a 160 px wide Hough image (docs/simd.md). Contexts that need more compute it
+ * per frame. */
 #ifndef HOME_HOUGH_GEOMETRY_BYTES
 #define HOME_HOUGH_GEOMETRY_BYTES (512u * 1024u)
 #endif

@@ -5,12 +5,13 @@
  * (home_config.max_model), which it fits as a similarity (translation, rotation, zoom about the
  * image centre); accumulates the camera path; smooths it with a constant-velocity Kalman filter
  * (each frame's measurement noise grows with the registration's predicted error sigma_px, so an
- * uncertain motion pulls the path less; a static scene registers as exactly no motion) and, with a lookahead of N frames, a
- * fixed-lag Rauch-Tung-Striebel smoother over those N frames; and returns the warp that shows
- * the smoothed camera through a crop window (margin m on each side, scaled to fill the frame).
- * The correction is shrunk towards identity whenever the window would leave the frame, so the
- * output never shows pixels from outside the input. A failed or implausible registration is
- * taken as "no motion": the path holds and the correction decays smoothly towards identity.
+ * uncertain motion pulls the path less; a static scene registers as exactly no motion) and, with a
+ * lookahead of N frames, a fixed-lag Rauch-Tung-Striebel smoother over those N frames; and returns
+ * the warp that shows the smoothed camera through a crop window (margin m on each side, scaled to
+ * fill the frame). The correction is shrunk towards identity whenever the window would leave the
+ * frame, so the output never shows pixels from outside the input. A failed or implausible
+ * registration is taken as "no motion": the path holds and the correction decays smoothly towards
+ * identity.
  *
  * Frames, latency and memory: the caller owns every frame buffer. home_stab_push() takes the
  * newest frame (only its luma is read) and, once N = lookahead frames are queued behind it,
@@ -76,17 +77,17 @@ typedef struct home_stab_config {
                                  refine_levels default), 0: off */
     int refine_finest_level;  /* HOME's refine_finest_level (see home_config): 0 = the
                                  refinement ends at the registration image's full size, 1 = at
-                                 half size (the default: on the bench clips jitter within
-                                 0.005 px, ITF within 0.01 dB of full size, for 22 % fewer
-                                 instructions per frame, see bench/stab) */
+                                 half size (the default: as steady as full size for less work;
+                                 docs/presets.md) */
     int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
                                  2x2- or 4x4-box downscaled copy (2, 4), see home_config; 0 =
                                  automatic (home_video_config's: a copy about 160 px wide) */
     int theta_bins;           /* HOME's theta bins; 0 = automatic (88, fewer than
                                  home_video_config's 120: the refinement gives the precision);
                                  fewer suit tiny frames */
-    int simd;                 /* enum home_simd for HOME and the warp (default: HOME_SIMD env or
-                                 the best compiled in) */
+    int simd;                 /* enum home_simd for HOME (default AUTO: the HOME_SIMD env or the
+                                 best compiled in); the warp takes the best this CPU has (all
+                                 backends give the same bytes) */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
     float max_rotation;       /* plausible per-frame rotation, radians */
     float max_zoom;           /* plausible per-frame |log scale| */
@@ -162,8 +163,8 @@ int home_stab_warp(const double *warp, const home_stab_image *src, home_stab_ima
  * chroma rows): the same bytes there, nothing else written. Bands on several threads split the
  * warp across cores (the library keeps no state: any thread may call it). I420 and NV12 bands
  * start and end on an even row; HOME_E_CONFIG otherwise or outside the frame. */
-int home_stab_warp_rows(const double *warp, const home_stab_image *src, home_stab_image *dst, int first_row,
-                        int rows);
+int home_stab_warp_rows(const double *warp, const home_stab_image *src, home_stab_image *dst,
+                        int first_row, int rows);
 
 /* Similarity parameters <-> 3x3 matrices (about the centre of a width x height frame). */
 void home_stab_sim_to_matrix(const home_stab_sim *s, int width, int height, double *m);

@@ -1,15 +1,70 @@
+# Measurements: speed against OpenCV ORB and instruction counts (bench), the refinement's
+# per-frame cost (bench-refine), the evaluation on real photographs (eval, eval-trust).
 # make bench: libhome vs OpenCV ORB in one run (needs g++ and Debian's libopencv-dev), plus
 # instruction counts per backend (valgrind callgrind) when valgrind is present.
-CXX ?= $(CROSS_COMPILE)g++
 BENCH_BIN := $(BUILD)/bin/home-bench
 OPENCV_FLAGS = $(shell pkg-config --cflags --libs opencv4 2>/dev/null)
 
 $(BENCH_BIN): bench/bench_vs_orb.cpp $(SUPPORT_OBJ) $(LIB) include/home.h
 	@mkdir -p $(dir $@)
 	@if [ -z "$(OPENCV_FLAGS)" ]; then echo "bench: needs libopencv-dev (apt-get install libopencv-dev g++ pkg-config)"; exit 1; fi
-	$(CXX) -std=c++17 -O2 -Iinclude -Iexamples bench/bench_vs_orb.cpp $(SUPPORT_OBJ) $(LIB) -o $@ $(OPENCV_FLAGS) -lm
+	$(CXX) -std=c++17 -O2 -Iinclude -Iexamples -Itests/support bench/bench_vs_orb.cpp $(SUPPORT_OBJ) $(LIB) -o $@ $(OPENCV_FLAGS) -lm
 
 .PHONY: bench
 bench: $(BENCH_BIN) $(BUILD)/bin/home-register $(BUILD)/bin/home-make-pair
 	$(BENCH_BIN) $(BENCH_RUNS)
 	BUILD=$(BUILD) bash bench/instructions.sh
+
+# make bench-refine: per-frame cost of the refinement (video case) next to HOME alone
+REFINE_BENCH := $(BUILD)/bin/home-bench-refine
+BINS += $(REFINE_BENCH)
+$(REFINE_BENCH): $(BUILD)/obj/bench/refine/bench_refine.o $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+.PHONY: bench-refine
+bench-refine: $(REFINE_BENCH)
+	$(RUNNER) $(REFINE_BENCH) --frames 40
+	$(RUNNER) $(REFINE_BENCH) --frames 40 --kind weak
+
+# Evaluation against ORB, AKAZE and LSD/LBD on real photographs (bench/eval, Python 3).
+#   make eval        full run: regenerates bench/eval/results.md and its plots
+#   make eval-quick  the CI subset: report in $(EVAL_CACHE)/quick/results.md
+#   make eval-trust        can `ok` be trusted (docs/trust.md)? tuning set vs test set, still
+#                          pairs, consecutive frames, static camera, and the sealed set's
+#                          static clips; rewrites bench/eval/trust_results.md,
+#                          trust_results.json.gz and trust_*.png
+#   make eval-trust-quick  its CI subset, tuning and test sets only (report in
+#                          $(EVAL_CACHE)/trust-quick/; fails only when the harness breaks,
+#                          never on the numbers)
+# Photographs come from Debian packages (apt-get download) into $(EVAL_CACHE).
+EVAL_CACHE ?= $(BUILD)/eval-cache
+EVAL_JOBS ?= 2
+EVAL_PYTHON ?= python3
+EVAL_PIP := numpy 'opencv-contrib-python-headless<5' matplotlib
+EVAL_RUN = $(EVAL_PYTHON) bench/eval/run.py --home $(BUILD)/bin/home-register \
+	--cache $(EVAL_CACHE) --jobs $(EVAL_JOBS)
+
+.PHONY: eval eval-quick eval-deps eval-trust eval-trust-quick
+eval-deps:
+	@$(EVAL_PYTHON) -c 'import numpy, matplotlib, cv2; cv2.line_descriptor.LSDDetector_createLSDDetector' 2>/dev/null \
+	|| $(EVAL_PYTHON) -m pip install --quiet $(EVAL_PIP) \
+	|| $(EVAL_PYTHON) -m pip install --quiet --break-system-packages $(EVAL_PIP)
+
+eval: $(BUILD)/bin/home-register eval-deps
+	$(EVAL_RUN)
+
+eval-quick: $(BUILD)/bin/home-register eval-deps
+	$(EVAL_RUN) --quick
+
+# EVAL_TRUST_ARGS: more trust.py options, e.g. --sets test --suites static (sets: tuning,
+#   test, sealed; sealed has static clips only), or
+#   --extra-args "--refine-trust 40" (passed to every home-register run)
+EVAL_TRUST_ARGS ?=
+EVAL_TRUST = $(EVAL_PYTHON) bench/eval/trust.py --home $(BUILD)/bin/home-register \
+	--stab $(BUILD)/bin/home-stab --cache $(EVAL_CACHE) --jobs $(EVAL_JOBS) $(EVAL_TRUST_ARGS)
+
+eval-trust: $(BUILD)/bin/home-register $(BUILD)/bin/home-stab eval-deps
+	$(EVAL_TRUST)
+
+eval-trust-quick: $(BUILD)/bin/home-register $(BUILD)/bin/home-stab eval-deps
+	$(EVAL_TRUST) --quick

@@ -1,8 +1,10 @@
 /* libhome's hot kernels: one table per SIMD backend, chosen per context at home_init().
  * Every backend must produce bit-identical results to the scalar reference (integer kernels),
- * which tests/test_kernels.c checks on odd sizes, unaligned pointers and extreme inputs. */
+ * which tests/test_backends.c checks on odd sizes, unaligned pointers and extreme inputs. */
 #ifndef HOME_KERNELS_H
 #define HOME_KERNELS_H
+#include "dispatch.h"
+#include "line_fit_kernels.h"
 #include <stddef.h>
 #include <stdint.h>
 
@@ -12,11 +14,6 @@
 #define HOME__MAX_TAPS_RADIUS 8
 /* Rows summed in 16-bit lanes before widening: 128 * 255 = 32640 fits int16. */
 #define HOME__RADON_ROWS_16BIT 128
-
-struct home__refine_kernels; /* port/refine_kernels.h */
-struct home__stab_kernels;   /* port/stab_kernels.h */
-struct home__line_fit;       /* src/home_internal.h */
-extern const struct home__line_fit home__line_fit_generic; /* src/homography.c */
 
 typedef struct home__kernels {
     const char *name;
@@ -33,21 +30,24 @@ typedef struct home__kernels {
      * (1 << 30 when absent). */
     void (*nearest2_l1)(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
                         int *best, int *d1, int *d2);
-    /* out[i] = sum_k taps[k] * in[i - radius + k] (k = 0 .. 2 radius, in this order), for i in
-     * [radius, n - radius): the interior of a row; callers handle the borders. */
-    void (*smooth_row)(const float *in, float *out, int n, const float *taps, int radius);
-    /* out[i] = sum_k taps[k] * rows[k][i] (k = 0 .. 2 radius, in this order), i in [0, n). */
-    void (*smooth_cols)(const float *const *rows, float *out, int n, const float *taps,
-                        int radius);
+    /* out[i] = sum_k taps[k] * in[i - radius + k] (k = 0 .. 2 radius, in this order) for i in
+     * [radius, e), the interior of a row up to e <= n - radius, which it returns; the caller
+     * (src/smooth.c) does the borders and the rest (home__smooth_row_px). */
+    int (*smooth_row)(const float *in, float *out, int n, const float *taps, int radius);
+    /* out[i] = sum_k taps[k] * rows[k][i] (k = 0 .. 2 radius, in this order) for i in [0, e),
+     * e <= n returned; the caller does the rest (home__smooth_cols_px). */
+    int (*smooth_cols)(const float *const *rows, float *out, int n, const float *taps,
+                       int radius);
     /* One row of a ds x ds box downscale (ds = 2 or 4), rounded:
      *   out[x] = (sum over v, u < ds of src[v*stride + ds*x + u] + ds*ds/2) / (ds*ds),
      * x in [0, out_w). */
     void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
-    /* Hough extremum candidates: the indices i in [1, n - 1), increasing, where mid[i] > 0 and
+    /* Hough extremum candidates: the indices i in [1, e), increasing, where mid[i] > 0 and
      * above all eight neighbours in up, mid, down at i - 1 .. i + 1, or mid[i] < 0 and below
-     * them all, into idx; returns how many (comparisons only: exact in every backend). */
+     * them all (home__is_extremum), into idx; returns how many and sets *end = e <= n - 1 (at
+     * least 1); the caller (src/extrema.c) tests the rest. Comparisons only: exact everywhere. */
     int (*extremum_candidates)(const float *up, const float *mid, const float *down, int n,
-                               int *idx);
+                               int *idx, int *end);
     /* The line-end terms of a theta row's lines that cross the image's side, i in [i0, i1)
      * (src/hough.c's shear geometry: line j0 + i meets row p at column j0 + i + shift[p]):
      *   sum[i] += left[entry[i]] + right_total - right[after[i]]
@@ -60,11 +60,8 @@ typedef struct home__kernels {
                       float *line);
     /* Linear resampling: out[i] = line[k[i]] + f[i] * (line[k[i] + 1] - line[k[i]]), i < n. */
     void (*resample)(const float *line, const int16_t *k, const float *f, int n, float *out);
-    /* the homography's line fit (src/line_fit.h compiled for this instruction set) */
-    const struct home__line_fit *line_fit;
-    /* the photometric refinement's and the stabiliser's kernels of the same backend */
-    const struct home__refine_kernels *refine;
-    const struct home__stab_kernels *stab;
+    /* the homography's line fit (port/line_fit.h compiled for this instruction set) */
+    const home__line_fit *line_fit;
 } home__kernels;
 
 /* The references of line_ends and resample at one index (scalar kernels and SIMD tails). */
@@ -98,15 +95,34 @@ extern const home__kernels home__kernels_sse;
 /* shared by the AVX2 table */
 void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
                            int *best, int *d1, int *d2);
-void home__smooth_row_sse(const float *in, float *out, int n, const float *taps, int radius);
-void home__smooth_cols_sse(const float *const *rows, float *out, int n, const float *taps,
-                           int radius);
 void home__box_down_sse(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
-int home__extremum_candidates_sse(const float *up, const float *mid, const float *down, int n,
-                                  int *idx);
 #endif
 
-/* The reference test of extremum_candidates at one index (scalar kernel and SIMD tails). */
+/* The references of smooth_row and smooth_cols for outputs [i0, i1) (the scalar kernels, and
+ * the callers for what the SIMD bodies leave). */
+static inline void home__smooth_row_px(const float *in, float *out, int i0, int i1,
+                                       const float *taps, int radius)
+{
+    int i, k;
+    for (i = i0; i < i1; i++) {
+        float acc = 0.0f;
+        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * in[i - radius + k];
+        out[i] = acc;
+    }
+}
+
+static inline void home__smooth_cols_px(const float *const *rows, float *out, int i0, int i1,
+                                        const float *taps, int radius)
+{
+    int i, k;
+    for (i = i0; i < i1; i++) {
+        float acc = 0.0f;
+        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * rows[k][i];
+        out[i] = acc;
+    }
+}
+
+/* The reference test of extremum_candidates at one index (scalar kernel and the callers). */
 static inline int home__is_extremum(const float *up, const float *mid, const float *down, int i)
 {
     const float v = mid[i];
@@ -119,17 +135,16 @@ static inline int home__is_extremum(const float *up, const float *mid, const flo
     return 0;
 }
 #if defined(__x86_64__) && !defined(HOME_NO_AVX2)
-/* port/avx2.c is compiled with -mavx2 and used only when the CPU reports AVX2 */
+/* the port/..._avx2.c files are compiled with -mavx2 and used only when the CPU reports AVX2 */
 #define HOME__HAVE_AVX2 1
 extern const home__kernels home__kernels_avx2;
-extern const struct home__line_fit home__line_fit_avx2; /* port/line_fit_avx2.c */
 #endif
 #if defined(__ARM_NEON) || defined(__ARM_NEON__)
 #define HOME__HAVE_NEON 1
 extern const home__kernels home__kernels_neon;
 #endif
 
-/* The one dispatch point. The table for a home_simd value (HOME_SIMD_AUTO picks the best
- * compiled in), or NULL when that backend is not compiled into this build. */
+
+/* The table for a home_simd value, or NULL when home__simd_resolve() refuses it. */
 const home__kernels *home__kernels_for(int simd);
 #endif

@@ -1,7 +1,7 @@
 /* AVX2 kernels of the refinement (compiled with -mavx2, used when the CPU reports AVX2): the
  * 3x3 blur, the 2x2 means and the selection keys, which touch every pixel of every frame's
- * snapshot, sixteen pixels per step, and the warp (gathers); the rest of the table is the SSE2 one. Bit-identical to
- * port/refine_scalar.c (integer arithmetic only). */
+ * snapshot, sixteen pixels per step, and the warp (gathers); the rest of the table is the SSE2 one.
+ * Bit-identical to port/refine_scalar.c (integer arithmetic only). */
 #include "kernels.h"
 #include "refine_kernels.h"
 #if defined(HOME__HAVE_AVX2) && defined(__AVX2__)
@@ -57,13 +57,15 @@ static void select_keys_avx2(const uint8_t *row, ptrdiff_t stride, int w, int b,
                              int16_t *keys, int accumulate)
 {
     const __m256i iota = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    const __m256i mask = _mm256_set1_epi16((short)(b - 1)), base = _mm256_set1_epi16((short)(dy * b));
+    const __m256i mask = _mm256_set1_epi16((short)(b - 1)),
+                  base = _mm256_set1_epi16((short)(dy * b));
     int x;
     if (!accumulate) keys[0] = keys[w - 1] = 0;
     for (x = 1; x + 16 <= w - 1; x += 16) {
         __m256i s = _mm256_add_epi16(absdiff16(row + x + 1, row + x - 1),
                                      absdiff16(row + x + stride, row + x - stride));
-        __m256i off = _mm256_add_epi16(base, _mm256_and_si256(_mm256_add_epi16(_mm256_set1_epi16((short)x), iota), mask));
+        __m256i off = _mm256_add_epi16(
+            base, _mm256_and_si256(_mm256_add_epi16(_mm256_set1_epi16((short)x), iota), mask));
         __m256i key = _mm256_or_si256(_mm256_slli_epi16(s, 4), off);
         __m256i *dst = (__m256i *)(void *)(keys + x);
         if (accumulate) key = _mm256_max_epi16(key, _mm256_loadu_si256(dst));
@@ -75,27 +77,37 @@ static void select_keys_avx2(const uint8_t *row, ptrdiff_t stride, int w, int b,
 /* Eight points per step: the reference's float arithmetic lane by lane (no FMA: -mavx2 alone),
  * each 2x2 support fetched as two 32-bit gathers (pixels p[0], p[1] in the low bytes; the image
  * has slack for the 2 bytes read past its last pixel). */
-static void warp_avx2(const float *m, const int16_t *xs, const int16_t *ys, int n, const uint8_t *img,
-                      ptrdiff_t stride, int w, int h, float *out)
+static void warp_avx2(const float *m, const int16_t *xs, const int16_t *ys, int n,
+                      const uint8_t *img, ptrdiff_t stride, int w, int h, float *out)
 {
     const __m256 xmax = _mm256_set1_ps((float)(w - 1)), ymax = _mm256_set1_ps((float)(h - 1));
-    const __m256 zero = _mm256_setzero_ps(), minus1 = _mm256_set1_ps(-1.0f), one = _mm256_set1_ps(1.0f);
+    const __m256 zero = _mm256_setzero_ps(), minus1 = _mm256_set1_ps(-1.0f),
+                 one = _mm256_set1_ps(1.0f);
     const __m256i vstride = _mm256_set1_epi32((int)stride), low8 = _mm256_set1_epi32(0xff);
-    const int *row0 = (const int *)(const void *)img, *row1 = (const int *)(const void *)(img + stride);
+    const int *row0 = (const int *)(const void *)img,
+              *row1 = (const int *)(const void *)(img + stride);
     __m256 mm[9];
     int i, k;
     for (k = 0; k < 9; k++) mm[k] = _mm256_set1_ps(m[k]);
     for (i = 0; i + 8 <= n; i += 8) {
-        __m256 x = _mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(xs + i))));
-        __m256 y = _mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(ys + i))));
-        __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(mm[6], x), _mm256_mul_ps(mm[7], y)), mm[8]);
+        __m256 x = _mm256_cvtepi32_ps(
+            _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(xs + i))));
+        __m256 y = _mm256_cvtepi32_ps(
+            _mm256_cvtepi16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(ys + i))));
+        __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(mm[6], x), _mm256_mul_ps(mm[7], y)),
+                                 mm[8]);
         __m256 inv = _mm256_div_ps(one, d);
-        __m256 px = _mm256_mul_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(mm[0], x), _mm256_mul_ps(mm[1], y)), mm[2]), inv);
-        __m256 py = _mm256_mul_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(mm[3], x), _mm256_mul_ps(mm[4], y)), mm[5]), inv);
-        __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(d, zero, _CMP_GT_OQ), _mm256_cmp_ps(px, zero, _CMP_GE_OQ)),
-                                  _mm256_and_ps(_mm256_cmp_ps(py, zero, _CMP_GE_OQ),
-                                                _mm256_and_ps(_mm256_cmp_ps(px, xmax, _CMP_LT_OQ),
-                                                              _mm256_cmp_ps(py, ymax, _CMP_LT_OQ))));
+        __m256 px = _mm256_mul_ps(
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(mm[0], x), _mm256_mul_ps(mm[1], y)), mm[2]),
+            inv);
+        __m256 py = _mm256_mul_ps(
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(mm[3], x), _mm256_mul_ps(mm[4], y)), mm[5]),
+            inv);
+        __m256 ok = _mm256_and_ps(
+            _mm256_and_ps(_mm256_cmp_ps(d, zero, _CMP_GT_OQ), _mm256_cmp_ps(px, zero, _CMP_GE_OQ)),
+            _mm256_and_ps(_mm256_cmp_ps(py, zero, _CMP_GE_OQ),
+                          _mm256_and_ps(_mm256_cmp_ps(px, xmax, _CMP_LT_OQ),
+                                        _mm256_cmp_ps(py, ymax, _CMP_LT_OQ))));
         __m256i ix, iy, at, up, down;
         __m256 fx, fy, p00, p01, p10, p11, top, bot;
         px = _mm256_and_ps(px, ok); /* invalid lanes sample (0, 0): in bounds, discarded */
@@ -113,7 +125,10 @@ static void warp_avx2(const float *m, const int16_t *xs, const int16_t *ys, int 
         p11 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(down, 8), low8));
         top = _mm256_add_ps(p00, _mm256_mul_ps(fx, _mm256_sub_ps(p01, p00)));
         bot = _mm256_add_ps(p10, _mm256_mul_ps(fx, _mm256_sub_ps(p11, p10)));
-        _mm256_storeu_ps(out + i, _mm256_blendv_ps(minus1, _mm256_add_ps(top, _mm256_mul_ps(fy, _mm256_sub_ps(bot, top))), ok));
+        _mm256_storeu_ps(
+            out + i,
+            _mm256_blendv_ps(minus1, _mm256_add_ps(top, _mm256_mul_ps(fy, _mm256_sub_ps(bot, top))),
+                             ok));
     }
     if (i < n) home__refine_warp_sse(m, xs + i, ys + i, n - i, img, stride, w, h, out + i);
 }
@@ -144,9 +159,16 @@ static void downsample_avx2(const uint8_t *src, ptrdiff_t src_stride, uint8_t *d
 }
 
 const home__refine_kernels home__refine_kernels_avx2 = {
-    "avx2", blur3_avx2, downsample_avx2, select_keys_avx2, home__refine_block_max_sse,
-    warp_avx2,
-    home__refine_accumulate_sse, home__refine_cauchy_sums_sse, home__refine_residuals_sse};
+    .name = "avx2",
+    .blur3 = blur3_avx2,
+    .downsample = downsample_avx2,
+    .select_keys = select_keys_avx2,
+    .block_max = home__refine_block_max_sse,
+    .warp = warp_avx2,
+    .accumulate = home__refine_accumulate_sse,
+    .cauchy_sums = home__refine_cauchy_sums_sse,
+    .residuals = home__refine_residuals_sse,
+};
 #else
 typedef int home__refine_avx2_unused; /* ISO C forbids an empty translation unit */
 #endif

@@ -2,16 +2,18 @@
  * context like home__kernels. Integer kernels are bit-identical to the scalar reference; the
  * float kernels are too, because every backend runs the same IEEE operations in the same order
  * on the same lane (point i is lane i % 4; no fused multiply-add, C99 contracts none), which
- * tests/test_refine.c checks on odd sizes and unaligned pointers. */
+ * tests/test_backends.c checks on odd sizes and unaligned pointers. */
 #ifndef HOME_REFINE_KERNELS_H
 #define HOME_REFINE_KERNELS_H
+#include "dispatch.h"
 #include <stddef.h>
 #include <stdint.h>
 
 #define HOME__REFINE_LANES 4
 #define HOME__REFINE_ACC 44   /* 36 upper-triangle entries of J^T W J, then 8 of J^T W r */
 
-/* Bytes readable past the last pixel of an image the warp samples (the pyramid levels have them). */
+/* Bytes readable past the last pixel of an image the warp samples (the pyramid levels have them).
+ */
 #define HOME__REFINE_IMAGE_SLACK 4
 
 typedef struct home__refine_kernels {
@@ -89,6 +91,15 @@ static inline void home__blur3_horizontal(const int16_t *tmp, uint8_t *d, int x0
     d[w - 1] = (uint8_t)((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
 }
 
+/* 2x2 means of row pair a, b for outputs [x0, w) (see downsample) */
+static inline void home__downsample_px(const uint8_t *a, const uint8_t *b, uint8_t *d, int x0,
+                                       int w)
+{
+    int x;
+    for (x = x0; x < w; x++)
+        d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
+}
+
 /* block maxima for blocks [i0, n) (see block_max) */
 static inline void home__block_max_px(const int16_t *keys, int i0, int n, int b, uint16_t *cells)
 {
@@ -137,6 +148,6 @@ extern const home__refine_kernels home__refine_kernels_avx2; /* port/refine_avx2
 extern const home__refine_kernels home__refine_kernels_neon;
 #endif
 
-/* The table for a home_simd value (AUTO: the best compiled in), NULL when not compiled in. */
+/* The table for a home_simd value (home__simd_resolve()), NULL when refused. */
 const home__refine_kernels *home__refine_kernels_for(int simd);
 #endif

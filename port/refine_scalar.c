@@ -18,12 +18,11 @@ static void blur3_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
 static void downsample_scalar(const uint8_t *src, ptrdiff_t src_stride, uint8_t *dst,
                               ptrdiff_t dst_stride, int dst_w, int dst_h)
 {
-    int x, y;
+    int y;
     for (y = 0; y < dst_h; y++) {
         const uint8_t *a = src + 2 * (ptrdiff_t)y * src_stride, *b = a + src_stride;
         uint8_t *d = dst + (ptrdiff_t)y * dst_stride;
-        for (x = 0; x < dst_w; x++)
-            d[x] = (uint8_t)((a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1] + 2) >> 2);
+        home__downsample_px(a, b, d, 0, dst_w);
     }
 }
 
@@ -48,7 +47,8 @@ static void warp_scalar(const float *m, const int16_t *xs, const int16_t *ys, in
             int ix = (int)px, iy = (int)py;
             float fx = px - (float)ix, fy = py - (float)iy;
             const uint8_t *p = img + (ptrdiff_t)iy * stride + ix;
-            float p00 = (float)p[0], p01 = (float)p[1], p10 = (float)p[stride], p11 = (float)p[stride + 1];
+            float p00 = (float)p[0], p01 = (float)p[1], p10 = (float)p[stride],
+                  p11 = (float)p[stride + 1];
             float top = p00 + fx * (p01 - p00);
             float bot = p10 + fx * (p11 - p10);
             out[i] = top + fy * (bot - top);
@@ -120,6 +120,13 @@ static void residuals_scalar(const float *b, const int16_t *t, const float *wt, 
 }
 
 const home__refine_kernels home__refine_kernels_scalar = {
-    "none", blur3_scalar, downsample_scalar, select_keys_scalar, block_max_scalar, warp_scalar,
-    accumulate_scalar,
-    cauchy_sums_scalar, residuals_scalar};
+    .name = "none",
+    .blur3 = blur3_scalar,
+    .downsample = downsample_scalar,
+    .select_keys = select_keys_scalar,
+    .block_max = block_max_scalar,
+    .warp = warp_scalar,
+    .accumulate = accumulate_scalar,
+    .cauchy_sums = cauchy_sums_scalar,
+    .residuals = residuals_scalar,
+};

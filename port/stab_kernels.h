@@ -1,8 +1,9 @@
 /* Kernels of the stabiliser's warp (src/warp.c): one table per SIMD backend, chosen like
  * home__kernels. Every backend gives the scalar reference's bytes exactly (integer arithmetic),
- * which tests/test_stab.c checks on odd widths, unaligned pointers and clamped rows. */
+ * which tests/test_backends.c checks on odd widths, unaligned pointers and clamped rows. */
 #ifndef HOME_STAB_KERNELS_H
 #define HOME_STAB_KERNELS_H
+#include "dispatch.h"
 #include <stddef.h>
 #include <stdint.h>
 
@@ -18,22 +19,31 @@
  * Requires w, h >= 2 and every coordinate of the row within int32. With the weights
  * fx, fy = HOME__WARP_WEIGHT of the (clamped) coordinates' fractions, the result is
  * ((p00 (128-fx) + p01 fx) (128-fy) + (p10 (128-fx) + p11 fx) fy + 2^13) >> 14, and every
- * implementation must give it bit for bit. */
+ * implementation must give it bit for bit. This is the reference (port/stab_scalar.c). */
 void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
                       int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n);
 
-/* HOME_OK when im is a usable frame: known format, size within HOME's limits (even where
- * chroma is subsampled), planes present, strides at least a row. */
-struct home_stab_image;
-int home__stab_check_image(const struct home_stab_image *im);
+/* The body of a warp row: home__warp_row_c's bytes for a planar row (step = dst_step = 1) whose
+ * every sample lies inside (home__warp_row_inside), n a positive multiple of the table's block.
+ * The caller (src/warp.c) sends other rows, and the tail, to the reference. */
+typedef void (*home__warp_row_fn)(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0,
+                                  int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int n);
 
-/* A warp row kernel (home__warp_row_c's contract). */
-typedef void (*home__warp_row_fn)(const uint8_t *src, ptrdiff_t stride, int step, int w, int h,
-                                  int32_t x0, int32_t y0, int32_t dx, int32_t dy, uint8_t *dst,
-                                  int dst_step, int n);
+/* The SIMD warp bodies follow the source row pair their groups of pixels sit on: for a group
+ * whose first pixel is at Q16 y and whose last `span` further, *lo becomes the first Q16 y of y's
+ * source row and *yrel the last pixel's y less *lo (wrapping); returns the row's first byte. */
+static inline const uint8_t *home__stab_track_row(const uint8_t *src, ptrdiff_t stride,
+                                                  uint32_t y, uint32_t span, uint32_t *lo,
+                                                  uint32_t *yrel)
+{
+    *lo = y & ~0xffffu;
+    *yrel = y + span - *lo;
+    return src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride;
+}
 
 typedef struct home__stab_kernels {
     const char *name;
+    int block;                 /* output pixels per step of warp_row */
     home__warp_row_fn warp_row;
 } home__stab_kernels;
 
@@ -51,7 +61,6 @@ extern const home__stab_kernels home__stab_kernels_avx2;   /* port/stab_avx2.c, 
 extern const home__stab_kernels home__stab_kernels_neon;
 #endif
 
-/* The table for a home_simd value (AVX2 contexts: port/stab_avx2.c's), or NULL when that
- * backend is not compiled in. */
+/* The table for a home_simd value (home__simd_resolve()), NULL when refused. */
 const home__stab_kernels *home__stab_kernels_for(int simd);
 #endif

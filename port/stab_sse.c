@@ -2,25 +2,25 @@
  * load each (pinsrw) at a column taken from a vector of the eight Q16 x (pextrw), from the row
  * pair the kernel tracks while the row of the warp stays on it (a near-horizontal warp: almost
  * always); a group that crosses a source row finds each pixel's rows. The blend is
- * port/stab_x86.h's. Rows that need clamping, or are not planar, use the reference. */
+ * port/stab_x86.h's. Body only: src/warp.c passes planar rows inside the source, n a multiple
+ * of eight, and finishes the tail. */
 #include "stab_kernels.h"
 #if defined(__SSE2__)
 #include "stab_x86.h"
 
-static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
-                         int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
+static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int w, int32_t x0, int32_t y0,
+                         int32_t dx, int32_t dy, uint8_t *dst, int n)
 {
-    const __m128i step_x = _mm_set1_epi16(home__stab_low16(0, dx, 8)), step_y = _mm_set1_epi16(home__stab_low16(0, dy, 8));
+    const __m128i step_x = _mm_set1_epi16(home__stab_low16(0, dx, 8)),
+                  step_y = _mm_set1_epi16(home__stab_low16(0, dy, 8));
     const __m128i step8 = _mm_set1_epi32(home__stab_wrap32(0, dx, 8));
     const uint32_t dy7 = 7u * (uint32_t)dy, dy8 = 8u * (uint32_t)dy;
     __m128i frac_x, frac_y, xa, xb, top, bot;
     const uint8_t *row;
-    uint8_t *d = dst, *const end = dst + (n & ~7);
-    uint32_t lo, yrel;   /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
-    if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
-        home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
-        return;
-    }
+    uint8_t *d = dst, *const end = dst + n;
+    /* lo: first Q16 y of the tracked source row; yrel: the group's last y - lo */
+    uint32_t lo, yrel;
+    (void)w; /* per-pixel loads: the row's width does not matter */
     {
         /* k dq & 0xffff = k (dq & 0xffff) & 0xffff: the fractions of pixels k = 0..7 are the
          * first's plus lanes k of these (wrapping like the Q16 sums) */
@@ -31,9 +31,7 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
                                _mm_mullo_epi16(_mm_set1_epi16(home__stab_low16(0, dy, 1)), lane));
     }
     home__stab_xs((uint32_t)x0, dx, &xa, &xb);
-    lo = (uint32_t)y0 & ~0xffffu;
-    yrel = (uint32_t)y0 + dy7 - lo;
-    row = src + (ptrdiff_t)(y0 >> HOME__WARP_FRAC_BITS) * stride;
+    row = home__stab_track_row(src, stride, (uint32_t)y0, dy7, &lo, &yrel);
     while (d < end) {
         /* affine: a group's first pixel is on the tracked row when the previous group's last
          * was, so its last decides */
@@ -41,11 +39,11 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
             home__stab_gather8(row, stride, xa, xb, &top, &bot);
         } else {   /* the group crosses a source row, here or before it: each pixel's own rows */
             const uint32_t y = lo + yrel - dy7, next = y + dy8;
-            home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)y, dx, dy, &top, &bot);
+            home__stab_gather8_rows(src, stride, (uint32_t)_mm_cvtsi128_si32(xa), (int32_t)y, dx,
+                                    dy, &top, &bot);
             if (d + 8 < end) {   /* next is a pixel of the row: inside; track its row */
-                lo = next & ~0xffffu;
-                yrel = y + dy7 - lo;   /* next + dy7 - lo after the step below */
-                row = src + (ptrdiff_t)(next >> HOME__WARP_FRAC_BITS) * stride;
+                /* yrel: next's (next + dy7 - lo) after the step below */
+                row = home__stab_track_row(src, stride, next, dy7 - dy8, &lo, &yrel);
             }
         }
         home__stab_blend8(top, bot, frac_x, frac_y, d);
@@ -56,14 +54,11 @@ static void warp_row_sse(const uint8_t *src, ptrdiff_t stride, int step, int w, 
         yrel += dy8;
         d += 8;
     }
-    if (d < dst + n) {   /* the rest of an inside row: the reference's fast path, same bytes */
-        const uint32_t i = (uint32_t)(d - dst);
-        home__warp_row_c(src, stride, 1, w, h, (int32_t)((uint32_t)x0 + i * (uint32_t)dx),
-                         (int32_t)((uint32_t)y0 + i * (uint32_t)dy), dx, dy, d, 1, n - (int)i);
-    }
 }
 
-const home__stab_kernels home__stab_kernels_sse = {"sse", warp_row_sse};
+const home__stab_kernels home__stab_kernels_sse = { .name = "sse",
+                                                    .block = 8,
+                                                    .warp_row = warp_row_sse };
 #else
 typedef int home__stab_sse_unused; /* ISO C forbids an empty translation unit */
 #endif

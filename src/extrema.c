@@ -10,7 +10,8 @@ static int ranks_below(const home__heap_entry *a, const home__heap_entry *b)
     return a->order > b->order;
 }
 
-void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool, int capacity)
+void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool,
+                     int capacity)
 {
     heap->entries = entries;
     heap->pool = pool;
@@ -57,7 +58,9 @@ void home__heap_push(home__heap *heap, const home__candidate *cand)
             int parent = (i - 1) / 2;
             home__heap_entry tmp;
             if (!ranks_below(&heap->entries[i], &heap->entries[parent])) break;
-            tmp = heap->entries[i]; heap->entries[i] = heap->entries[parent]; heap->entries[parent] = tmp;
+            tmp = heap->entries[i];
+            heap->entries[i] = heap->entries[parent];
+            heap->entries[parent] = tmp;
             i = parent;
         }
     } else if (ranks_below(&heap->entries[0], &e)) {
@@ -80,11 +83,20 @@ int home__heap_sort_desc(home__heap *heap)
     return heap->count;
 }
 
+int home__extremum_candidates(const home__kernels *kernels, const float *up, const float *mid,
+                              const float *down, int n, int *idx)
+{
+    int end, count = kernels->extremum_candidates(up, mid, down, n, idx, &end);
+    for (; end < n - 1; end++) /* what the kernel left: the reference */
+        if (home__is_extremum(up, mid, down, end)) idx[count++] = end;
+    return count;
+}
+
 int home__detect_row(const home__kernels *kernels, const float *const *rows, int centre, int r_bins,
                      int theta_bins, int *candidates, home__extremum *out)
 {
     const float *up = rows[0], *mid = rows[1], *down = rows[2];
-    const int n_candidates = kernels->extremum_candidates(up, mid, down, r_bins, candidates);
+    const int n_candidates = home__extremum_candidates(kernels, up, mid, down, r_bins, candidates);
     int c, n = 0;
     for (c = 0; c < n_candidates; c++) {
         const int i = candidates[c];
@@ -103,7 +115,8 @@ int home__detect_row(const home__kernels *kernels, const float *const *rows, int
         step_r = -(h_tt * g_r - h_tr * g_t) / det;
         if (fabs(step_t) > 1.0 || fabs(step_r) > 1.0) continue;
         theta = centre + step_t;
-        if (theta < 0.0 || theta >= theta_bins) continue; /* the padding only serves as neighbours */
+        /* the padding only serves as neighbours */
+        if (theta < 0.0 || theta >= theta_bins) continue;
         out[n].theta_bin = (float)theta;
         out[n].r_bin = (float)(i + step_r);
         out[n].saliency = (float)fabs(det / (h_tt + h_rr));

@@ -4,6 +4,8 @@
 
 #include "home.h"
 #include "kernels.h"
+#include <math.h>
+#include "line_fit_kernels.h"
 #include "refine_kernels.h"
 
 #define HOME__MAGIC_CTX 0x484f4d43u   /* "HOMC" */
@@ -39,12 +41,6 @@ typedef struct home__extremum {
     float theta_bin, r_bin, saliency;
     int sign;
 } home__extremum;
-
-/* A candidate match: line (theta_a, r_a) in A against (theta_b, r_b) in B. */
-typedef struct home__match {
-    float theta_a, r_a, theta_b, r_b;
-    double cos_a, sin_a, cos_b, sin_b; /* precomputed for the homography fit */
-} home__match;
 
 /* refine.c: template points of one pyramid level, structure of arrays padded to 4 lanes */
 typedef struct home__refine_points {
@@ -102,7 +98,8 @@ struct home_context {
     float smooth_taps[2 * HOME__MAX_SMOOTH_RADIUS + 1];
     const home__kernels *kernels;     /* SIMD backend */
     /* arena-backed buffers */
-    int16_t *grad_x, *grad_y;         /* EXACT: width x height central differences, 0 on the border */
+    /* EXACT: width x height central differences, 0 on the border */
+    int16_t *grad_x, *grad_y;
     uint8_t *img_n, *img_t;           /* FAST: the image and its transpose, zero-padded by
                                          HOME__RADON_BLOCK columns on each side */
     ptrdiff_t img_n_stride, img_t_stride;
@@ -131,10 +128,32 @@ struct home_context {
     home__refine_state refine;
 };
 
-/* arena.c */
+/* Arena blocks start on this boundary (cache line, widest SIMD load). */
+#define HOME__BLOCK_ALIGN 64u
+
+/* n rounded up to a multiple of a (a power of two) */
+static inline size_t home__align_up(size_t n, size_t a) { return (n + a - 1) & ~(a - 1); }
+
+/* The offset of the next block of bytes at *cursor (HOME__BLOCK_ALIGN), and the cursor past it. */
+static inline size_t home__take(size_t *cursor, size_t bytes)
+{
+    const size_t at = home__align_up(*cursor, HOME__BLOCK_ALIGN);
+    *cursor = at + bytes;
+    return at;
+}
+
+/* 1 when v is finite and in [lo, hi] */
+static inline int home__finite_in(double v, double lo, double hi)
+{
+    return isfinite(v) && v >= lo && v <= hi;
+}
+
+/* config.c */
 uint32_t home__config_id(const home_config *cfg);
 int home__r_bins(const home_config *cfg);
 void home__hough_size(const home_config *cfg, int *width, int *height);
+
+/* common.c: the image check and the clock every stage uses */
 int home__check_image(const home_context *ctx, const uint8_t *image, ptrdiff_t stride);
 double home__now(const home_context *ctx);
 
@@ -156,6 +175,10 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
 void home__hough_raw_rows(const home_config *cfg, int radius, int *first, int *count);
 /* Fill a geometry record (its arrays already carved) for theta. */
 void home__theta_geometry(const home_context *ctx, double theta, home__theta_geom *g);
+/* The Hough stage's arena block: its bytes, and its buffers and geometry laid out in it (the
+ * context's sizes, cfg and r_bins, already set). */
+size_t home__hough_bytes(const home_config *cfg);
+void home__hough_init(home_context *ctx, unsigned char *block);
 double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t stride,
                           home__row_fn on_row, void *user);
 
@@ -163,9 +186,14 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
 int home__gauss_taps(float sigma, float *taps);
 void home__smooth_r(const home__kernels *kernels, const float *in, float *out, int n,
                     const float *taps, int radius);
+/* Along theta: out[i] = sum_k taps[k] rows[k][i], i in [0, n) (the smooth_cols kernel and the
+ * reference for what it leaves). */
+void home__smooth_theta(const home__kernels *kernels, const float *const *rows, float *out, int n,
+                        const float *taps, int radius);
 
 /* extrema.c */
-void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool, int capacity);
+void home__heap_init(home__heap *heap, home__heap_entry *entries, home__candidate *pool,
+                     int capacity);
 int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t order);
 void home__heap_push(home__heap *heap, const home__candidate *cand);
 /* Sorts the entries, most salient first; the i-th is then &pool[entries[i].slot]. Returns the
@@ -174,6 +202,10 @@ int home__heap_sort_desc(home__heap *heap);
 /* Scan smoothed row rows[1] (rows[0..2] = centre-1 .. centre+1) for strict extrema with a valid
  * Newton step whose refined theta lies in [0, theta_bins); returns how many were written.
  * candidates: r_bins ints of scratch. */
+/* The strict signed 3x3 extrema of row mid, i in [1, n - 1), into idx; how many (the kernel's
+ * body, then the reference for the rest). */
+int home__extremum_candidates(const home__kernels *kernels, const float *up, const float *mid,
+                              const float *down, int n, int *idx);
 int home__detect_row(const home__kernels *kernels, const float *const *rows, int centre, int r_bins,
                      int theta_bins, int *candidates, home__extremum *out);
 
@@ -194,31 +226,14 @@ int home__estimate_homography(home_context *ctx, int n_matches, home_result *res
 int home__homography_plausible(const double *h, int width, int height);
 
 /* lm.c: minimise a sum of squares over 8 parameters. The problem supplies its cost and, when
- * jtj is not NULL, the Gauss-Newton normal equations J^T J (8x8, row-major) and J^T e at p, so
- * it can exploit the structure of its Jacobian. */
-typedef double (*home__normal_fn)(const void *user, const double *p, double *jtj, double *jte);
+ * jtj is not NULL, the Gauss-Newton normal equations (home__normal_fn, port/line_fit_kernels.h),
+ * so it can exploit the structure of its Jacobian. */
 int home__lm_solve(double *p, home__normal_fn fn, const void *user, int max_iters);
 int home__solve_spd8(double *a, double *b);
 /* The same in two steps, to solve for several right-hand sides with one factor. */
 int home__cholesky8(double *a);
 void home__cholesky_solve8(const double *l, double *b);
 
-/* line_fit.h: the homography's line fit over matched lines, one implementation compiled per
- * instruction set (the backend's table picks it); the same bits from each. */
-typedef struct home__line_problem {
-    const home__match *matches;
-    const int *index;        /* the inliers the fit runs over */
-    int n;
-    double scale, inv_scale; /* half diagonal, px: normalises r */
-    double w_theta, w_r;     /* residual weights into Hough bins */
-} home__line_problem;
-typedef struct home__line_fit {
-    /* cost, and J^T J, J^T e when jtj is not NULL, over the inliers (home__lm_solve's fn) */
-    home__normal_fn normal;
-    /* the matches (of n) whose transfer error at g is under threshold, into index; how many */
-    int (*select_inliers)(const home__line_problem *lp, int n, const double *g, double threshold,
-                          int *index);
-} home__line_fit;
 
 /* model.c: motion-model selection over a fit's Fisher information (see there) */
 #define HOME__SPACE_H 0          /* parameters: the homography's entries h0..h7 */

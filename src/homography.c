@@ -11,11 +11,6 @@
 #include <math.h>
 #include <string.h>
 
-#define HOME__LINE_FIT_NAME(name) home__##name
-#include "line_fit.h"
-
-const home__line_fit home__line_fit_generic = {home__line_normal, home__select_inliers};
-
 static double det3(const double *m)
 {
     return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +

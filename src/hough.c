@@ -55,7 +55,8 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
         uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
         memset(row, 0, (size_t)pad);
         if (ds > 1)
-            ctx->kernels->box_down(image + (ptrdiff_t)(ds * y) * stride, stride, ds, row + pad, width);
+            ctx->kernels->box_down(image + (ptrdiff_t)(ds * y) * stride, stride, ds, row + pad,
+                                   width);
         else
             memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
         memset(row + pad + width, 0, (size_t)pad);
@@ -76,8 +77,8 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
 /* The image a theta family reads, in processing order: its column 0 of row 0, the row step,
  * rows and columns. vertical: lines within 45 degrees of the columns (the image itself), else
  * the transposed image; flip: rows taken bottom to top. */
-static const uint8_t *family_image(const home_context *ctx, int vertical, int flip, ptrdiff_t *stride,
-                                   int *rows, int *cols)
+static const uint8_t *family_image(const home_context *ctx, int vertical, int flip,
+                                   ptrdiff_t *stride, int *rows, int *cols)
 {
     const ptrdiff_t img_stride = vertical ? ctx->img_n_stride : ctx->img_t_stride;
     const uint8_t *img = (vertical ? ctx->img_n : ctx->img_t) + HOME__RADON_BLOCK;
@@ -181,7 +182,8 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
     g->end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
     {
         /* r bin i sits at intercept index jf = (i - r_centre) step / a + (cols-1)/2 - j0; the
-         * bins with jf in [0, n - 1) are a contiguous range (jf is monotonic in i), zero elsewhere */
+         * bins with jf in [0, n - 1) are a contiguous range (jf is monotonic in i), zero elsewhere
+         */
         const double dj = ctx->cfg.r_step / a;
         const double jf0 = -0.5 * (ctx->r_bins - 1) * dj + 0.5 * (cols - 1) - j0;
         const double last = (double)(n - 1);
@@ -301,8 +303,10 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
 
         j = k - radius; /* the theta-smoothed row now complete */
         for (i = 0; i < raw_ring; i++)
-            raw_window[i] = ctx->raw_rows + (size_t)((j - radius + i - first_raw) % raw_ring) * r_bins;
-        ctx->kernels->smooth_cols(raw_window, ctx->smooth_rows +
+            raw_window[i] = ctx->raw_rows +
+                            (size_t)((j - radius + i - first_raw) % raw_ring) * r_bins;
+        home__smooth_theta(ctx->kernels, raw_window,
+                           ctx->smooth_rows +
                                (size_t)((j - first_smooth) % HOME__DESC_ROWS) * r_bins,
                            r_bins, ctx->smooth_taps, radius);
         for (i = 0; i < HOME__DESC_ROWS; i++) {
@@ -318,4 +322,150 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
     }
     spent = home__now(ctx) - t0;
     return spent;
+}
+
+/* The Hough stage's block of the arena: offsets from its start, each on a HOME__BLOCK_ALIGN
+ * boundary. EXACT: the gradients; FAST: the image and its transpose, the theta rows' geometry
+ * (every row's when it fits HOME_HOUGH_GEOMETRY_BYTES, else one scratch record), line sums,
+ * border prefix sums and J over the intercepts. Both: one theta row's sums, the smoothing rings. */
+typedef struct hough_layout {
+    size_t grad_x, grad_y, img_n, img_t, geom, geom_scratch, line_sum, edge_prefix, line_j;
+    size_t acc_x, acc_y, raw_rows, smooth_rows, row_tmp, total;
+    size_t geom_bytes;                /* one record's arrays */
+    size_t geom_intercepts;           /* a row's intercepts, without the kernel's block slack */
+    ptrdiff_t img_n_stride, img_t_stride;
+    int geom_rows, geom_first;        /* raw theta rows cached (0: none) and the first's k */
+    int geom_longest, geom_blocks;
+} hough_layout;
+
+/* Bytes of one theta geometry record's arrays, each on a 16-byte boundary. */
+static size_t geom_record_bytes(int longest, int blocks, size_t intercepts, size_t r_bins)
+{
+    return home__align_up(((size_t)longest + 1) * sizeof(int16_t), 16) +
+           2 * home__align_up((size_t)blocks * sizeof(int16_t), 16) +
+           home__align_up(((size_t)longest + 4) * sizeof(int32_t), 16) +
+           2 * home__align_up(intercepts * sizeof(int16_t), 16) +
+           home__align_up(r_bins * sizeof(int16_t), 16) +
+           home__align_up(r_bins * sizeof(float), 16);
+}
+
+/* Point a record's arrays into mem (geom_record_bytes of it). */
+static void carve_geom(home__theta_geom *g, unsigned char *mem, int longest, int blocks,
+                       size_t intercepts, size_t r_bins)
+{
+    g->shift = (int16_t *)(void *)mem; /* + 1: line_ends may read a word at the last row */
+    mem += home__align_up(((size_t)longest + 1) * sizeof(int16_t), 16);
+    g->row_lo = (int16_t *)(void *)mem;
+    mem += home__align_up((size_t)blocks * sizeof(int16_t), 16);
+    g->row_hi = (int16_t *)(void *)mem;
+    mem += home__align_up((size_t)blocks * sizeof(int16_t), 16);
+    g->first_row = (int32_t *)(void *)mem;
+    mem += home__align_up(((size_t)longest + 4) * sizeof(int32_t), 16);
+    g->entry = (int16_t *)(void *)mem;
+    mem += home__align_up(intercepts * sizeof(int16_t), 16);
+    g->after = (int16_t *)(void *)mem;
+    mem += home__align_up(intercepts * sizeof(int16_t), 16);
+    g->res_k = (int16_t *)(void *)mem;
+    mem += home__align_up(r_bins * sizeof(int16_t), 16);
+    g->res_f = (float *)(void *)mem;
+}
+
+static void hough_plan(const home_config *cfg, hough_layout *l)
+{
+    size_t cur = 0, pixels = (size_t)cfg->width * (size_t)cfg->height;
+    size_t r_bins = (size_t)home__r_bins(cfg);
+    size_t radius = (size_t)ceil(3.0 * cfg->smooth_sigma); /* as home__gauss_taps() */
+    int hough_w, hough_h;
+    size_t w, h, longest, intercepts;
+    if (radius > HOME__MAX_SMOOTH_RADIUS) radius = HOME__MAX_SMOOTH_RADIUS;
+    home__hough_size(cfg, &hough_w, &hough_h);
+    w = (size_t)hough_w;
+    h = (size_t)hough_h;
+    longest = w > h ? w : h;
+    /* intercepts of one theta row: the other side + both shear extents + derivative + a block */
+    intercepts = w + h + 8 + 2 * HOME__RADON_BLOCK;
+    memset(l, 0, sizeof *l);
+    if (cfg->hough_method == HOME_HOUGH_EXACT) {
+        l->grad_x = home__take(&cur, pixels * sizeof(int16_t));
+        l->grad_y = home__take(&cur, pixels * sizeof(int16_t));
+    } else {
+        int rows;
+        size_t bytes;
+        l->img_n_stride = (ptrdiff_t)(w + 2 * HOME__RADON_BLOCK);
+        l->img_t_stride = (ptrdiff_t)(h + 2 * HOME__RADON_BLOCK);
+        l->img_n = home__take(&cur, h * (size_t)l->img_n_stride);
+        l->img_t = home__take(&cur, w * (size_t)l->img_t_stride);
+        l->geom_longest = (int)longest;
+        l->geom_blocks = (int)(intercepts / HOME__RADON_BLOCK + 1);
+        l->geom_intercepts = w + h + 8;
+        l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, l->geom_intercepts,
+                                          r_bins);
+        home__hough_raw_rows(cfg, (int)radius, &l->geom_first, &rows);
+        bytes = home__align_up((size_t)rows * sizeof(home__theta_geom), 16) +
+                (size_t)rows * l->geom_bytes;
+        if (bytes <= HOME_HOUGH_GEOMETRY_BYTES) {
+            l->geom_rows = rows;
+            l->geom = home__take(&cur, bytes);
+        } else {
+            l->geom_scratch = home__take(&cur, l->geom_bytes);
+        }
+        l->line_sum = home__take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(int32_t));
+        l->edge_prefix = home__take(&cur, 4 * 2 * (longest + 1) * sizeof(int32_t));
+        l->line_j = home__take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(float));
+    }
+    l->acc_x = home__take(&cur, r_bins * sizeof(int32_t));
+    l->acc_y = home__take(&cur, r_bins * sizeof(int32_t));
+    l->raw_rows = home__take(&cur, (2 * radius + 1) * r_bins * sizeof(float));
+    l->smooth_rows = home__take(&cur, HOME__DESC_ROWS * r_bins * sizeof(float));
+    l->row_tmp = home__take(&cur, r_bins * sizeof(float));
+    l->total = home__align_up(cur, HOME__BLOCK_ALIGN);
+}
+
+size_t home__hough_bytes(const home_config *cfg)
+{
+    hough_layout l;
+    hough_plan(cfg, &l);
+    return l.total;
+}
+
+void home__hough_init(home_context *ctx, unsigned char *block)
+{
+    const home_config *cfg = &ctx->cfg;
+    hough_layout l;
+    hough_plan(cfg, &l);
+    ctx->smooth_radius = home__gauss_taps(cfg->smooth_sigma, ctx->smooth_taps);
+    if (cfg->hough_method == HOME_HOUGH_EXACT) {
+        ctx->grad_x = (int16_t *)(void *)(block + l.grad_x);
+        ctx->grad_y = (int16_t *)(void *)(block + l.grad_y);
+    } else {
+        ctx->img_n = block + l.img_n;
+        ctx->img_t = block + l.img_t;
+        ctx->img_n_stride = l.img_n_stride;
+        ctx->img_t_stride = l.img_t_stride;
+        if (l.geom_rows) {
+            /* records first, then their arrays; every row's geometry computed once, here */
+            unsigned char *arrays =
+                block + l.geom + home__align_up((size_t)l.geom_rows * sizeof(home__theta_geom), 16);
+            int k;
+            ctx->geom = (home__theta_geom *)(void *)(block + l.geom);
+            for (k = 0; k < l.geom_rows; k++) {
+                carve_geom(&ctx->geom[k], arrays + (size_t)k * l.geom_bytes, l.geom_longest,
+                           l.geom_blocks, l.geom_intercepts, (size_t)ctx->r_bins);
+                home__theta_geometry(ctx, (l.geom_first + k) * HOME__PI / cfg->theta_bins,
+                                     &ctx->geom[k]);
+            }
+        } else {
+            ctx->geom = NULL;
+            carve_geom(&ctx->geom_scratch, block + l.geom_scratch, l.geom_longest, l.geom_blocks,
+                       l.geom_intercepts, (size_t)ctx->r_bins);
+        }
+        ctx->line_sum = (int32_t *)(void *)(block + l.line_sum);
+        ctx->edge_prefix = (int32_t *)(void *)(block + l.edge_prefix);
+        ctx->line_j = (float *)(void *)(block + l.line_j);
+    }
+    ctx->acc_x = (int32_t *)(void *)(block + l.acc_x);
+    ctx->acc_y = (int32_t *)(void *)(block + l.acc_y);
+    ctx->raw_rows = (float *)(void *)(block + l.raw_rows);
+    ctx->smooth_rows = (float *)(void *)(block + l.smooth_rows);
+    ctx->row_tmp = (float *)(void *)(block + l.row_tmp);
 }

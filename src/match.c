@@ -64,7 +64,8 @@ static void sort_by_theta(home_context *ctx, const home_features *b, int lo, int
         sift_down(b, idx, i, 0);
     }
     for (i = 0; i < n; i++) {
-        memcpy(ctx->window_desc + (size_t)(lo + i) * HOME_DESC_LEN, b->kp[idx[i]].desc, HOME_DESC_LEN);
+        memcpy(ctx->window_desc + (size_t)(lo + i) * HOME_DESC_LEN, b->kp[idx[i]].desc,
+               HOME_DESC_LEN);
         ctx->window_theta[lo + i] = b->kp[idx[i]].theta;
     }
 }
@@ -104,17 +105,21 @@ int home__match_features(home_context *ctx, const home_features *a, const home_f
     }
     for (i = 0; i < a->n_pos + a->n_neg; i++) {
         const home_keypoint *q = &a->kp[i];
-        int same_lo = q->sign > 0 ? 0 : b->n_pos, same_hi = q->sign > 0 ? b->n_pos : b->n_pos + b->n_neg;
-        int opp_lo = q->sign > 0 ? b->n_pos : 0, opp_hi = q->sign > 0 ? b->n_pos + b->n_neg : b->n_pos;
+        int same_lo = q->sign > 0 ? 0 : b->n_pos,
+            same_hi = q->sign > 0 ? b->n_pos : b->n_pos + b->n_neg;
+        int opp_lo = q->sign > 0 ? b->n_pos : 0,
+            opp_hi = q->sign > 0 ? b->n_pos + b->n_neg : b->n_pos;
         float alt_theta = q->theta < (float)(HOME__PI / 2) ? q->theta + (float)HOME__PI
                                                             : q->theta - (float)HOME__PI;
-        int j = window > 0.0f ? best_match_window(ctx, q->desc, q->theta, same_lo, same_hi, window, ratio)
-                              : best_match(ctx->kernels, q->desc, b, same_lo, same_hi, ratio);
+        int j = window > 0.0f
+                    ? best_match_window(ctx, q->desc, q->theta, same_lo, same_hi, window, ratio)
+                    : best_match(ctx->kernels, q->desc, b, same_lo, same_hi, ratio);
         if (j >= 0 && n < ctx->max_matches)
             match_keypoints(&ctx->matches[n++], q, &b->kp[j]);
         if (!q->has_alt) continue;
-        j = window > 0.0f ? best_match_window(ctx, q->alt_desc, alt_theta, opp_lo, opp_hi, window, ratio)
-                          : best_match(ctx->kernels, q->alt_desc, b, opp_lo, opp_hi, ratio);
+        j = window > 0.0f
+                ? best_match_window(ctx, q->alt_desc, alt_theta, opp_lo, opp_hi, window, ratio)
+                : best_match(ctx->kernels, q->alt_desc, b, opp_lo, opp_hi, ratio);
         if (j >= 0 && n < ctx->max_matches)
             home__match_set(&ctx->matches[n++], alt_theta, -q->r, b->kp[j].theta, b->kp[j].r);
     }

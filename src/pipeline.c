@@ -24,7 +24,7 @@ static int check_ctx(const home_context *ctx)
 
 /* Four partial sums (element i in lane i % 4), added (0 + 1) + (2 + 3) at the end: a fixed order
  * on every target, and four independent chains instead of one (a single running sum waits on
- * each addition: ~5 % of a video frame's time). */
+ * each addition; docs/simd.md). */
 static void accumulate_stats(extract_state *st, const float *row, int n)
 {
     double s[4] = {0.0, 0.0, 0.0, 0.0}, s2[4] = {0.0, 0.0, 0.0, 0.0};
@@ -98,7 +98,8 @@ static void fill_keypoints(const home_context *ctx, home__heap *heap, int sign, 
         const home__candidate *c = &heap->pool[heap->entries[i].slot];
         home_keypoint *kp = &out[i];
         kp->theta = (float)(c->theta_bin * (HOME__PI / n_theta));
-        if (kp->theta >= (float)HOME__PI) kp->theta = nextafterf((float)HOME__PI, 0.0f); /* [0, pi) */
+        /* [0, pi) */
+        if (kp->theta >= (float)HOME__PI) kp->theta = nextafterf((float)HOME__PI, 0.0f);
         /* r in full-image px: scale up from the (possibly downscaled) Hough image and move to
          * the full image's centre */
         kp->cos_theta = cos((double)kp->theta);
@@ -107,7 +108,8 @@ static void fill_keypoints(const home_context *ctx, home__heap *heap, int sign, 
                         kp->cos_theta * ctx->hough_dx + kp->sin_theta * ctx->hough_dy);
         kp->saliency = c->saliency;
         kp->sign = (int8_t)sign;
-        kp->has_alt = (uint8_t)(c->theta_bin < (float)band || c->theta_bin > (float)(n_theta - band));
+        kp->has_alt = (uint8_t)(c->theta_bin < (float)band ||
+                                c->theta_bin > (float)(n_theta - band));
         home__quantise_descriptor(c->samples, scale, 0, kp->desc);
         if (kp->has_alt)
             home__quantise_descriptor(c->samples, scale, 1, kp->alt_desc);

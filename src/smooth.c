@@ -15,7 +15,8 @@ int home__gauss_taps(float sigma, float *taps)
     return radius;
 }
 
-/* Borders (where taps fall off the r axis) here; the interior through the SIMD kernel. */
+/* Borders (where taps fall off the r axis) here; the interior through the SIMD kernel, and the
+ * interior's end it leaves by the reference. */
 void home__smooth_r(const home__kernels *kernels, const float *in, float *out, int n,
                     const float *taps, int radius)
 {
@@ -29,5 +30,14 @@ void home__smooth_r(const home__kernels *kernels, const float *in, float *out, i
         for (k = lo; k <= hi; k++) acc += taps[k] * in[i - radius + k];
         out[i] = acc;
     }
-    if (n > 2 * radius) kernels->smooth_row(in, out, n, taps, radius);
+    if (n > 2 * radius)
+        home__smooth_row_px(in, out, kernels->smooth_row(in, out, n, taps, radius), n - radius,
+                            taps, radius);
+}
+
+void home__smooth_theta(const home__kernels *kernels, const float *const *rows, float *out, int n,
+                        const float *taps, int radius)
+{
+    home__smooth_cols_px(rows, out, kernels->smooth_cols(rows, out, n, taps, radius), n, taps,
+                         radius);
 }

@@ -1,6 +1,6 @@
 /* Similarities about the frame centre: composition, inverse, scaling, and the least-squares
  * similarity through what HOME's homography does to a grid of the frame. */
-#include "stab_state.h"
+#include "stab_internal.h"
 #include <math.h>
 
 #define STAB_FIT_GRID 5                   /* similarity fitted to H on a 5x5 grid of the frame */

@@ -1,6 +1,6 @@
 /* The camera path: a constant-velocity Kalman filter per component, fixed-lag RTS smoothing
  * over the lookahead, and the stream's ends mirrored so that they are smoothed like the rest. */
-#include "stab_state.h"
+#include "stab_internal.h"
 #include <string.h>
 
 #define STAB_INIT_VEL_VAR 1.0             /* prior variance of the path velocity, (px/frame)^2 */

@@ -5,8 +5,7 @@
  * window); the similarities are in stab_motion.c, the path's filter in stab_path.c. */
 #include "home_stab.h"
 #include "kernels.h"
-#include "stab_kernels.h"
-#include "stab_state.h"
+#include "stab_internal.h"
 #include <math.h>
 #include <string.h>
 

@@ -2,70 +2,8 @@
  * is converted once to Q16 integers, so every row's start and step are exact integers and the
  * output is the same bit for bit on every platform and in every kernel version. */
 #include "home_stab.h"
-#include "stab_kernels.h"
+#include "stab_internal.h"
 #include <math.h>
-
-/* The reference's arithmetic on one 2x2 neighbourhood p (p[0], p[step], p[stride],
- * p[stride + step]) with 7-bit weights: every intermediate fits int16 and the vertical blend
- * int32, which SSE2's pmaddwd and NEON's widening multiplies compute exactly. */
-static uint8_t blend(const uint8_t *p, ptrdiff_t stride, int step, uint32_t fx, uint32_t fy)
-{
-    const uint32_t top = p[0] * (128 - fx) + p[step] * fx;
-    const uint32_t bot = p[stride] * (128 - fx) + p[stride + step] * fx;
-    return (uint8_t)((top * (128 - fy) + bot * fy + 8192u) >> 14);
-}
-
-/* Inner loop for a row whose every sample lies inside [0, w-1) x [0, h-1): no clamping. Gives
- * the same bytes as the clamped loop there (xi = x >> 16 <= w - 2 already). */
-static void warp_row_inside(const uint8_t *src, ptrdiff_t stride, int step, int32_t x, int32_t y,
-                            int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
-{
-    int i;
-    for (i = 0; i < n; i++, x += dx, y += dy)
-        dst[(ptrdiff_t)i * dst_step] =
-            blend(src + (ptrdiff_t)(y >> HOME__WARP_FRAC_BITS) * stride + (ptrdiff_t)(x >> HOME__WARP_FRAC_BITS) * step,
-                  stride, step, HOME__WARP_WEIGHT(x & 0xffff), HOME__WARP_WEIGHT(y & 0xffff));
-}
-
-int home__warp_row_inside(int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, int n)
-{
-    const int32_t x_max = (int32_t)(w - 1) << HOME__WARP_FRAC_BITS;
-    const int32_t y_max = (int32_t)(h - 1) << HOME__WARP_FRAC_BITS;
-    const int64_t x1 = (int64_t)x0 + (int64_t)dx * (n - 1), y1 = (int64_t)y0 + (int64_t)dy * (n - 1);
-    /* affine: the row's extremes are its ends */
-    return n > 0 && x0 >= 0 && x0 < x_max && x1 >= 0 && x1 < x_max && y0 >= 0 && y0 < y_max &&
-           y1 >= 0 && y1 < y_max;
-}
-
-void home__warp_row_c(const uint8_t *src, ptrdiff_t stride, int step, int w, int h, int32_t x0,
-                      int32_t y0, int32_t dx, int32_t dy, uint8_t *dst, int dst_step, int n)
-{
-    const int32_t x_max = (int32_t)(w - 1) << HOME__WARP_FRAC_BITS;
-    const int32_t y_max = (int32_t)(h - 1) << HOME__WARP_FRAC_BITS;
-    int32_t x = x0, y = y0;
-    int i;
-    if (home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
-        if (step == 1 && dst_step == 1)   /* planar: constant steps let the compiler do better */
-            warp_row_inside(src, stride, 1, x0, y0, dx, dy, dst, 1, n);
-        else
-            warp_row_inside(src, stride, step, x0, y0, dx, dy, dst, dst_step, n);
-        return;
-    }
-    for (i = 0; i < n; i++, x += dx, y += dy) {
-        /* clamp into the plane; at the last column/row use the pair (w-2, w-1) with weight 128 */
-        int32_t xc = x < 0 ? 0 : x > x_max ? x_max : x;
-        int32_t yc = y < 0 ? 0 : y > y_max ? y_max : y;
-        int32_t xi = xc >> HOME__WARP_FRAC_BITS, yi = yc >> HOME__WARP_FRAC_BITS;
-        if (xi > w - 2) xi = w - 2;
-        if (yi > h - 2) yi = h - 2;
-        dst[(ptrdiff_t)i * dst_step] =
-            blend(src + (ptrdiff_t)yi * stride + (ptrdiff_t)xi * step, stride, step,
-                  HOME__WARP_WEIGHT(xc - (xi << HOME__WARP_FRAC_BITS)),
-                  HOME__WARP_WEIGHT(yc - (yi << HOME__WARP_FRAC_BITS)));
-    }
-}
-
-const home__stab_kernels home__stab_kernels_scalar = {"none", home__warp_row_c};
 
 /* One component plane of a frame: where its samples are and how it is subsampled. */
 typedef struct plane_view {
@@ -142,6 +80,26 @@ static int check_image(const home_stab_image *im)
 
 int home__stab_check_image(const home_stab_image *im) { return check_image(im); }
 
+/* One output row (home__warp_row_c's contract) by the table k: its body kernel takes the planar
+ * rows inside the source up to a multiple of its block, the reference the rest. */
+void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t stride, int step,
+                    int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, uint8_t *dst,
+                    int dst_step, int n)
+{
+    int body;
+    if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
+        home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
+        return;
+    }
+    body = n - n % k->block;
+    if (body > 0) k->warp_row(src, stride, w, x0, y0, dx, dy, dst, body);
+    if (body < n) /* inside too: the reference's fast path */
+        home__warp_row_c(src, stride, 1, w, h,
+                         (int32_t)((uint32_t)x0 + (uint32_t)body * (uint32_t)dx),
+                         (int32_t)((uint32_t)y0 + (uint32_t)body * (uint32_t)dy), dx, dy,
+                         dst + body, 1, n - body);
+}
+
 static int32_t to_q16(double v) { return (int32_t)floor(v * 65536.0 + 0.5); }
 
 int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image *dst)
@@ -149,11 +107,11 @@ int home_stab_warp(const double *m, const home_stab_image *src, home_stab_image 
     return home_stab_warp_rows(m, src, dst, 0, dst ? dst->height : 0);
 }
 
-int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_image *dst, int first_row, int rows)
+int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_image *dst,
+                        int first_row, int rows)
 {
     plane_view views[3];
     const home__stab_kernels *kern;
-    home_config simd_choice;
     int status, n, k, j;
     double limit_x, limit_y;
     static const double corners[4][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
@@ -164,7 +122,8 @@ int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_i
         return HOME_E_MISMATCH;
     /* a band of whole chroma rows: with vertically subsampled chroma it starts and ends even */
     if (first_row < 0 || rows < 1 || rows > dst->height - first_row) return HOME_E_CONFIG;
-    if ((dst->format == HOME_STAB_I420 || dst->format == HOME_STAB_NV12) && (first_row % 2 || rows % 2))
+    if ((dst->format == HOME_STAB_I420 || dst->format == HOME_STAB_NV12) &&
+        (first_row % 2 || rows % 2))
         return HOME_E_CONFIG;
     for (k = 0; k < 9; k++)
         if (!isfinite(m[k])) return HOME_E_CONFIG;
@@ -179,9 +138,9 @@ int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_i
         if (u < -limit_x + src->width || u > limit_x || v < -limit_y + src->height || v > limit_y)
             return HOME_E_CONFIG;
     }
-    /* the backend HOME would use (HOME_SIMD honoured); all give the same bytes */
-    home_default_config(&simd_choice, HOME_MIN_SIDE, HOME_MIN_SIDE);
-    kern = home__stab_kernels_for(simd_choice.simd);
+    /* the best backend here (port/dispatch.c; CPU detection, no getenv per band): all give the
+     * same bytes, which tests/test_backends.c checks for every backend */
+    kern = home__stab_kernels_for(HOME__SIMD_BEST);
     if (!kern) kern = &home__stab_kernels_scalar;
     n = plane_views(src, dst, views);
     for (k = 0; k < n; k++) {
@@ -195,8 +154,9 @@ int home_stab_warp_rows(const double *m, const home_stab_image *src, home_stab_i
         /* each row starts from its own index (no running sum): a band's bytes are the whole
          * warp's */
         for (j = first_row / p->sub_y; j < (first_row + rows) / p->sub_y; j++)
-            kern->warp_row(p->src, p->src_stride, p->step, p->w, p->h, bq * j + cq, eq * j + fq, aq,
-                           dq, p->dst + (ptrdiff_t)j * p->dst_stride, p->step, p->w);
+            home__warp_row(kern, p->src, p->src_stride, p->step, p->w, p->h, bq * j + cq,
+                           eq * j + fq, aq, dq, p->dst + (ptrdiff_t)j * p->dst_stride, p->step,
+                           p->w);
     }
     return HOME_OK;
 }

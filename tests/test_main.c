@@ -13,7 +13,8 @@
     X(hough_wrap_symmetry) X(descriptor_invariance) X(homography_plausible) X(lm_exact_lines) X(halving_with_outliers) X(theta_window_prior) \
     X(end_to_end_structured) X(end_to_end_weak_texture) X(downscaled_hough) X(video_config) X(video_reuse_matches_pair) \
     X(deterministic_output) X(fails_cleanly) X(bad_inputs) X(kernels_radon) X(kernels_line_ends) X(kernels_resample) X(kernels_nearest) \
-    X(kernels_smooth) X(kernels_box_down) X(kernels_extremum_candidates) X(backends_identical_output) X(fast_hough_matches_exact) \
+    X(kernels_smooth) X(kernels_box_down) X(kernels_extremum_candidates) X(refine_kernels_backends) \
+    X(warp_backends_identical) X(warp_plane_end) X(backends_identical_output) X(fast_hough_matches_exact) \
     X(static_scene_is_identity) X(shift_is_translation) X(model_cap) X(sigma_calibrated) X(few_edges_never_wrong) \
     X(textured_mover_never_steers)
 

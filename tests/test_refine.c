@@ -525,90 +525,6 @@ void test_kernels_match_references(void)
     }
 }
 
-/* Every compiled-in backend reproduces the scalar kernels bit for bit: odd sizes, unaligned
- * pointers, points leaving the image, extreme grey levels. */
-void test_kernels_backends_identical(void)
-{
-    static const int simds[3] = {HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
-    const home__refine_kernels *ref = home__refine_kernels_for(HOME_SIMD_NONE);
-    static uint8_t src[101 * 67 + 64], d_ref[101 * 67], d_simd[101 * 67];
-    static int16_t t_ref[128], t_simd[128], k_ref[128], k_simd[128];
-    static int16_t xs[260], ys[260], gx[260], gy[260];
-    static float r[260], w[260], o_ref[260], o_simd[260], a_ref[44 * 4], a_simd[44 * 4];
-    static float w_ref[260], w_simd[260], r_simd[260];
-    const float aff[3] = {0.0123f, -0.71f, -0.4f};
-    float m[9];
-    synth_rng rng;
-    int s, i, off, tested = 0;
-    synth_seed(&rng, 99);
-    for (i = 0; i < (int)sizeof src; i++)
-        src[i] = (uint8_t)(i % 7 == 0 ? 255 * (i % 2) : synth_uniform(&rng) * 256);
-    for (i = 0; i < 260; i++) {
-        xs[i] = (int16_t)(synth_uniform(&rng) * 110 - 5);
-        ys[i] = (int16_t)(synth_uniform(&rng) * 75 - 4);
-        gx[i] = (int16_t)(synth_uniform(&rng) * 1020 - 510);
-        gy[i] = (int16_t)(synth_uniform(&rng) * 1020 - 510);
-        r[i] = (float)(synth_gauss(&rng) * 30);
-        w[i] = (float)synth_uniform(&rng);
-    }
-    m[0] = 1.01f; m[1] = 0.02f; m[2] = 0.7f; m[3] = -0.015f; m[4] = 0.99f; m[5] = -1.3f;
-    m[6] = 1e-4f; m[7] = -2e-4f; m[8] = 1.0f;
-    for (s = 0; s < 3; s++) {
-        const home__refine_kernels *k = home__refine_kernels_for(simds[s]);
-        if (!k) continue;
-        tested++;
-        for (off = 0; off < 3; off++) {
-            const uint8_t *in = src + off;
-            int width = 101 - 2 * off, height = 67 - off, b, dy;
-            ref->blur3(in, 101, d_ref, 101, width, height, t_ref);
-            k->blur3(in, 101, d_simd, 101, width, height, t_simd);
-            CHECK(memcmp(d_ref, d_simd, sizeof d_ref) == 0);
-            ref->downsample(in, 101, d_ref, 50, width / 2, height / 2);
-            k->downsample(in, 101, d_simd, 50, width / 2, height / 2);
-            CHECK(memcmp(d_ref, d_simd, sizeof d_ref) == 0);
-            for (b = 1; b <= 4; b *= 2)
-                for (dy = 0; dy < b; dy++) {
-                    ref->select_keys(in + 101 * (dy + 1), 101, width, b, dy, k_ref, dy > 0);
-                    k->select_keys(in + 101 * (dy + 1), 101, width, b, dy, k_simd, dy > 0);
-                    CHECK(memcmp(k_ref, k_simd, (size_t)width * sizeof *k_ref) == 0);
-                }
-            for (b = 2; b <= 4; b += 2) {
-                /* keys from the rows above (non-negative, < 2^13), an odd count of blocks */
-                static uint16_t c_ref[64], c_simd[64];
-                const int blocks = (width - 1) / b;
-                ref->block_max(k_ref, blocks, b, c_ref);
-                k->block_max(k_ref, blocks, b, c_simd);
-                CHECK(memcmp(c_ref, c_simd, (size_t)blocks * sizeof *c_ref) == 0);
-            }
-            /* 252: a count of whole 4-point lanes that is not one of 8 (AVX2's tail) */
-            ref->warp(m, xs + off, ys + off, 252, in, 101, width, height, o_ref);
-            k->warp(m, xs + off, ys + off, 252, in, 101, width, height, o_simd);
-            CHECK(memcmp(o_ref, o_simd, 252 * sizeof *o_ref) == 0);
-            ref->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_ref);
-            k->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_simd);
-            CHECK(memcmp(o_ref, o_simd, 256 * sizeof *o_ref) == 0);
-            ref->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 1, a_ref);
-            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 1, a_simd);
-            CHECK(memcmp(a_ref, a_simd, sizeof a_ref) == 0);
-            /* J^T W r alone: the same sums, J^T W J left as it was */
-            memset(a_simd, 0x7f, sizeof a_simd);
-            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 0, a_simd);
-            CHECK(memcmp(a_ref + 36 * 4, a_simd + 36 * 4, 8 * 4 * sizeof *a_ref) == 0);
-            CHECK(a_simd[0] == a_simd[35 * 4 + 3] && a_simd[0] != a_ref[0]);
-            /* gain/bias fit: o_ref holds warped samples (some -1), r doubles as the keep mask */
-            CHECK_EQ_INT(ref->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_ref, a_ref),
-                         k->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_simd, a_simd));
-            CHECK(memcmp(w_ref, w_simd, 256 * sizeof *w_ref) == 0);
-            CHECK(memcmp(a_ref, a_simd, 20 * sizeof *a_ref) == 0);
-            ref->residuals(o_ref, gy + off, w_ref, 256, 0.93f, 2.25f, o_simd);
-            k->residuals(o_ref, gy + off, w_ref, 256, 0.93f, 2.25f, r_simd);
-            CHECK(memcmp(o_simd, r_simd, 256 * sizeof *r_simd) == 0);
-        }
-        printf("     %s: identical to scalar\n", k->name);
-    }
-    if (!tested) printf("     no SIMD backend compiled in\n");
-}
-
 void test_arena_and_config(void)
 {
     home_config cfg, bad;
@@ -653,7 +569,7 @@ void test_refine_bad_inputs(void)
 }
 
 #define TEST_LIST(X) \
-    X(kernels_match_references) X(kernels_backends_identical) X(arena_and_config) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
+    X(kernels_match_references) X(arena_and_config) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
     X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)

@@ -25,12 +25,14 @@ import sys
 EXTERNAL_BYTES = 512
 
 # Indirect calls, resolved conservatively: the caller's clock hook runs on the caller's stack
-# and is not counted; a SIMD kernel's indirect calls are its scalar tails (port/*scalar.c); any
+# and is not counted; a SIMD kernel's indirect calls are the scalar kernels (port/*scalar.c); any
 # other indirect call may reach any kernel in port/ or either library callback. Listed callers
 # first (caller pattern -> callee patterns), then the defaults.
 CLOCK_HOOK_CALLERS = ["home__now", "home_stab_push"]
 CALLBACKS = ["src/pipeline.c:on_row", "src/homography.c:line_residual"]
-INDIRECT = {"home__detect_row": ["port/*"]}   # its one indirect call: the extremum scan kernel
+# their one indirect call: a kernel (the extremum scan, the smoothing along r and theta, the warp)
+INDIRECT = {"home__extremum_candidates": ["port/*"], "home__smooth_r": ["port/*"],
+            "home__smooth_theta": ["port/*"], "home__warp_row": ["port/*"]}
 
 NODE = re.compile(r'node: \{ title: "([^"]+)" label: "([^"]*)"( shape : ellipse)?')
 EDGE = re.compile(r'edge: \{ sourcename: "([^"]+)" targetname: "([^"]+)"')

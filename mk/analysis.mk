@@ -1,36 +1,8 @@
-# Hardening (issue 7): the bad-input table and registration-failure tests (home-hardening-tests),
-# the fuzz corpus replayed through the harnesses (home-fuzz-replay), both run by `make test`;
+# Hardening tools (the bad-input and fuzz-replay test binaries are in mk/tests.mk):
 #   make fuzz       build the libFuzzer harnesses with clang and fuzz each for FUZZ_SECONDS
 #   make lint       cppcheck and gcc -fanalyzer over src/ and port/
 #   make stack      worst-case stack of every public function (-fstack-usage call graph) <= 16 KiB
 #   make valgrind   memcheck over the bad-input table, the fuzz corpus and small end-to-end runs
-
-# --- test binaries ------------------------------------------------------------------------
-HARD_TEST_OBJ := $(patsubst tests/%.c,$(BUILD)/obj/tests/%.o,$(wildcard tests/test_bad_input*.c))
-HARD_TESTS := $(BUILD)/bin/home-hardening-tests
-FUZZ_REPLAY := $(BUILD)/bin/home-fuzz-replay
-FUZZ_TARGETS := api stab pgm y4m
-FUZZ_REPLAY_OBJ := $(foreach t,$(FUZZ_TARGETS),$(BUILD)/obj/fuzz-replay/fuzz_$(t).o)
-FUZZ_SUPPORT := $(SUPPORT_OBJ) $(BUILD)/obj/examples/y4m.o
-BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
-TEST_BINS += $(HARD_TESTS) $(FUZZ_REPLAY)
-
-$(HARD_TESTS): $(HARD_TEST_OBJ) $(BUILD)/obj/tests/test_runner.o $(FUZZ_SUPPORT) $(LIB)
-	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) -pthread
-
-FUZZ_TARGET_LIST := $(foreach t,$(FUZZ_TARGETS),X($(t)))
-$(BUILD)/obj/fuzz-replay/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h include/home.h include/home_stab.h $(wildcard examples/*.h)
-	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) -DLLVMFuzzerTestOneInput=fuzz_$*_one -c $< -o $@
-
-$(BUILD)/obj/fuzz-replay/replay.o: tests/fuzz/replay.c $(MAKEFILE_LIST)
-	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) '-DFUZZ_TARGETS(X)=$(FUZZ_TARGET_LIST)' -c $< -o $@
-
-$(FUZZ_REPLAY): $(BUILD)/obj/fuzz-replay/replay.o $(FUZZ_REPLAY_OBJ) $(FUZZ_SUPPORT) $(LIB)
-	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 
 # --- libFuzzer ----------------------------------------------------------------------------
 # The library and support objects are built by this Makefile's own rules in FUZZ_BUILD with
@@ -48,7 +20,7 @@ fuzz-build:
 # The pixel loops (Hough transform, smoothing, gradients, extrema, descriptors, refinement and
 # warp kernels) keep edge coverage and the sanitizers but not comparison tracing: trace-cmp's call
 # on every loop test was 70% of an execution and only fed loop bounds and pixel values to the
-# mutator. Validation and decisions (arena.c, match.c, homography.c, stabilise.c) keep it;
+# mutator. Validation and decisions (config.c, context.c, match.c, homography.c, stabilise.c) keep it;
 # pipeline.c (the per-row detection callback) and lm.c (the solver's loops) were a further 10%.
 FUZZ_NO_TRACE_CMP := $(wildcard port/*.c) src/hough.c src/smooth.c src/gradient.c src/extrema.c \
 	src/describe.c $(wildcard src/refine*.c) src/warp.c src/pipeline.c src/lm.c
@@ -58,7 +30,7 @@ endif
 
 fuzz-bins: $(foreach t,$(FUZZ_TARGETS),$(BUILD)/fuzz/fuzz_$(t))
 
-$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(FUZZ_SUPPORT) $(LIB)
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) -fsanitize=fuzzer $< $(FUZZ_SUPPORT) $(LIB) -o $@ $(LDFLAGS_APP)
 

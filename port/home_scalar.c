@@ -1,7 +1,5 @@
 /* Scalar reference kernels: the definition every SIMD backend must reproduce bit for bit. */
 #include "kernels.h"
-#include "refine_kernels.h"
-#include "stab_kernels.h"
 #include <string.h>
 
 static void radon_blocks_scalar(const uint8_t *base, ptrdiff_t stride, const int16_t *shift,
@@ -13,7 +11,8 @@ static void radon_blocks_scalar(const uint8_t *base, ptrdiff_t stride, const int
         int32_t *acc = out + (ptrdiff_t)b * HOME__RADON_BLOCK;
         memset(acc, 0, HOME__RADON_BLOCK * sizeof *acc);
         for (p = row_lo[b]; p <= row_hi[b]; p++) {
-            const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK + shift[p];
+            const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK +
+                                 shift[p];
             for (l = 0; l < HOME__RADON_BLOCK; l++) acc[l] += src[l];
         }
     }
@@ -33,25 +32,17 @@ static void nearest2_l1_scalar(const uint8_t *query, const uint8_t *cands, ptrdi
     *best = b; *d1 = m1; *d2 = m2;
 }
 
-static void smooth_row_scalar(const float *in, float *out, int n, const float *taps, int radius)
+static int smooth_row_scalar(const float *in, float *out, int n, const float *taps, int radius)
 {
-    int i, k;
-    for (i = radius; i < n - radius; i++) {
-        float acc = 0.0f;
-        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * in[i - radius + k];
-        out[i] = acc;
-    }
+    home__smooth_row_px(in, out, radius, n - radius, taps, radius);
+    return n - radius;
 }
 
-static void smooth_cols_scalar(const float *const *rows, float *out, int n, const float *taps,
-                               int radius)
+static int smooth_cols_scalar(const float *const *rows, float *out, int n, const float *taps,
+                              int radius)
 {
-    int i, k;
-    for (i = 0; i < n; i++) {
-        float acc = 0.0f;
-        for (k = 0; k <= 2 * radius; k++) acc += taps[k] * rows[k][i];
-        out[i] = acc;
-    }
+    home__smooth_cols_px(rows, out, 0, n, taps, radius);
+    return n;
 }
 
 static void box_down_scalar(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w)
@@ -67,11 +58,12 @@ static void box_down_scalar(const uint8_t *src, ptrdiff_t stride, int ds, uint8_
 }
 
 static int extremum_candidates_scalar(const float *up, const float *mid, const float *down, int n,
-                                      int *idx)
+                                      int *idx, int *end)
 {
     int i, count = 0;
     for (i = 1; i < n - 1; i++)
         if (home__is_extremum(up, mid, down, i)) idx[count++] = i;
+    *end = i;
     return count;
 }
 
@@ -92,8 +84,15 @@ void home__resample_scalar(const float *line, const int16_t *k, const float *f, 
     for (i = 0; i < n; i++) out[i] = home__resample_px(line, k[i], f[i]);
 }
 
-const home__kernels home__kernels_scalar = {"none", radon_blocks_scalar, nearest2_l1_scalar,
-                                            smooth_row_scalar, smooth_cols_scalar, box_down_scalar,
-                                            extremum_candidates_scalar,
-                                            home__line_ends_scalar, home__resample_scalar, &home__line_fit_generic,
-    &home__refine_kernels_scalar, &home__stab_kernels_scalar};
+const home__kernels home__kernels_scalar = {
+    .name = "none",
+    .radon_blocks = radon_blocks_scalar,
+    .nearest2_l1 = nearest2_l1_scalar,
+    .smooth_row = smooth_row_scalar,
+    .smooth_cols = smooth_cols_scalar,
+    .box_down = box_down_scalar,
+    .extremum_candidates = extremum_candidates_scalar,
+    .line_ends = home__line_ends_scalar,
+    .resample = home__resample_scalar,
+    .line_fit = &home__line_fit_scalar,
+};

@@ -1,12 +1,11 @@
-/* The line fit's arithmetic (src/homography.c): the transfer residuals of matched lines, the
- * normal equations of the LM solver and the inlier selection. Included by src/homography.c
- * (the reference, every backend) and by port/line_fit_avx2.c, the same source compiled with
+/* The line fit's arithmetic (port/line_fit_kernels.h), written once: included by
+ * port/line_fit_scalar.c (the reference) and port/line_fit_avx2.c, the same source compiled with
  * AVX2 so each four-lane step is one 256-bit operation: element-wise IEEE arithmetic in C99
  * mode (no contraction, no reassociation), so both give the same bits. The includer defines
- * HOME__LINE_FIT_NAME(name), the exported names. */
+ * its table from line_normal and select_inliers. */
 #ifndef HOME_LINE_FIT_H
 #define HOME_LINE_FIT_H
-#include "home_internal.h"
+#include "line_fit_kernels.h"
 #include <math.h>
 #include <string.h>
 
@@ -24,8 +23,9 @@ typedef struct line_lanes {
 /* Residuals e (3 components) of matches m[0..FIT_LANES) at g; lanes with valid 0 get e = k = 0.
  * With jacobian, also the numbers de/dg is made of: with l the line in A, rows 0..2 of de/dg
  * are (k0 l, k1 l, 0, 0), (k1 l, k2 l, 0, 0) and (k3 l, k4 l, k5 l0, k5 l1). */
-static void line_residuals(const home__line_problem *lp, const home__match *const *m, const double *valid,
-                           const double *restrict g, int jacobian, line_lanes *restrict out)
+static void line_residuals(const home__line_problem *lp, const home__match *const *m,
+                           const double *valid, const double *restrict g, int jacobian,
+                           line_lanes *restrict out)
 {
     double a[FIT_LANES], b[FIT_LANES], c[FIT_LANES], inv_n[FIT_LANES], cb[FIT_LANES],
         sb[FIT_LANES], rb[FIT_LANES];
@@ -80,7 +80,7 @@ static void gather_lanes(const home__line_problem *lp, const int *index, int i, 
 
 /* Cost, and J^T J, J^T e over the inliers. J^T J is made of blocks s * l l^T: six symmetric
  * 3x3 sums (36 products per line instead of the 192 of the dense 3x8 Jacobian). */
-double HOME__LINE_FIT_NAME(line_normal)(const void *user, const double *g, double *jtj, double *jte)
+static double line_normal(const void *user, const double *g, double *jtj, double *jte)
 {
     const home__line_problem *lp = (const home__line_problem *)user;
     /* blocks: AA, AB, BB (3x3), AC, BC (3x2), CC (2x2) over l l^T's entries 00 01 02 11 12 22 */
@@ -135,7 +135,8 @@ double HOME__LINE_FIT_NAME(line_normal)(const void *user, const double *g, doubl
             for (u = 0; u < 6; u++)
                 sum[t][u] = (blk[t][u][0] + blk[t][u][1]) + (blk[t][u][2] + blk[t][u][3]);
         for (t = 0; t < 3; t++)
-            for (u = 0; u < 3; u++) evs[t][u] = (ev[t][u][0] + ev[t][u][1]) + (ev[t][u][2] + ev[t][u][3]);
+            for (u = 0; u < 3; u++)
+                evs[t][u] = (ev[t][u][0] + ev[t][u][1]) + (ev[t][u][2] + ev[t][u][3]);
         for (t = 0; t < 3; t++) {
             for (u = 0; u < 3; u++) {
                 const int q = ll_index[t][u];
@@ -159,8 +160,8 @@ double HOME__LINE_FIT_NAME(line_normal)(const void *user, const double *g, doubl
     return (cost[0] + cost[1]) + (cost[2] + cost[3]);
 }
 
-int HOME__LINE_FIT_NAME(select_inliers)(const home__line_problem *lp, int n, const double *g,
-                                         double threshold, int *index)
+static int select_inliers(const home__line_problem *lp, int n, const double *g, double threshold,
+                          int *index)
 {
     int i, j, count = 0;
     const double t2 = threshold * threshold;

@@ -1,10 +1,15 @@
-/* Every compiled SIMD backend against the scalar reference, bit for bit: odd sizes, unaligned
- * pointers, negative strides, random and extreme inputs; then the whole pipeline per backend. */
+/* The backend-equivalence test: every compiled SIMD backend of every kernel table (HOME's,
+ * the refinement's, the stabiliser's warp) against the scalar reference, bit for bit, through
+ * the callers that finish what the kernel bodies leave: odd sizes, unaligned pointers, negative
+ * strides, random and extreme inputs; then the whole pipeline per backend. */
 #include "test.h"
 #include "test_util.h"
 #include "home_internal.h"
+#include "stab_internal.h"
 #include "synth.h"
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const int backends[] = {HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
@@ -190,19 +195,19 @@ void test_kernels_smooth(void)
             rows[k] = in[k] + offset;
         }
         memset(want, 0, sizeof want);
-        home__kernels_scalar.smooth_row(in[0] + offset, want, n, taps, radius);
+        home__smooth_r(&home__kernels_scalar, in[0] + offset, want, n, taps, radius);
         for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
             const home__kernels *kr = home__kernels_for(backends[bi]);
             if (!kr) continue;
             memset(got, 0, sizeof got);
-            kr->smooth_row(in[0] + offset, got, n, taps, radius);
+            home__smooth_r(kr, in[0] + offset, got, n, taps, radius);
             CHECK(memcmp(want, got, sizeof want) == 0);
         }
-        home__kernels_scalar.smooth_cols(rows, want, n, taps, radius);
+        home__smooth_theta(&home__kernels_scalar, rows, want, n, taps, radius);
         for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
             const home__kernels *kr = home__kernels_for(backends[bi]);
             if (!kr) continue;
-            kr->smooth_cols(rows, got, n, taps, radius);
+            home__smooth_theta(kr, rows, got, n, taps, radius);
             CHECK(memcmp(want, got, (size_t)n * sizeof *got) == 0);
         }
     }
@@ -272,13 +277,13 @@ void test_kernels_extremum_candidates(void)
             if ((v > 0.0f && above) || (v < 0.0f && below)) want[want_n++] = i;
         }
         total += want_n;
-        count = home__kernels_scalar.extremum_candidates(up, mid, down, n, got);
+        count = home__extremum_candidates(&home__kernels_scalar, up, mid, down, n, got);
         CHECK_EQ_INT(count, want_n);
         CHECK(memcmp(want, got, (size_t)want_n * sizeof *want) == 0);
         for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
             const home__kernels *kr = home__kernels_for(backends[bi]);
             if (!kr) continue;
-            count = kr->extremum_candidates(up, mid, down, n, got);
+            count = home__extremum_candidates(kr, up, mid, down, n, got);
             CHECK_EQ_INT(count, want_n);
             CHECK(memcmp(want, got, (size_t)want_n * sizeof *want) == 0);
         }
@@ -351,4 +356,195 @@ void test_fast_hough_matches_exact(void)
     }
     printf("     %d of 80 strongest exact-transform keypoints found by the fast transform\n", found);
     CHECK(found >= 64);
+}
+
+/* The refinement's kernels (port/refine_kernels.h): every compiled-in backend reproduces the
+ * scalar kernels bit for bit: odd sizes, unaligned pointers, points leaving the image, extreme
+ * grey levels. */
+void test_refine_kernels_backends(void)
+{
+    static const int simds[3] = {HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
+    const home__refine_kernels *ref = home__refine_kernels_for(HOME_SIMD_NONE);
+    static uint8_t src[101 * 67 + 64], d_ref[101 * 67], d_simd[101 * 67];
+    static int16_t t_ref[128], t_simd[128], k_ref[128], k_simd[128];
+    static int16_t xs[260], ys[260], gx[260], gy[260];
+    static float r[260], w[260], o_ref[260], o_simd[260], a_ref[44 * 4], a_simd[44 * 4];
+    static float w_ref[260], w_simd[260], r_simd[260];
+    const float aff[3] = {0.0123f, -0.71f, -0.4f};
+    float m[9];
+    synth_rng rng;
+    int s, i, off, tested = 0;
+    synth_seed(&rng, 99);
+    for (i = 0; i < (int)sizeof src; i++)
+        src[i] = (uint8_t)(i % 7 == 0 ? 255 * (i % 2) : synth_uniform(&rng) * 256);
+    for (i = 0; i < 260; i++) {
+        xs[i] = (int16_t)(synth_uniform(&rng) * 110 - 5);
+        ys[i] = (int16_t)(synth_uniform(&rng) * 75 - 4);
+        gx[i] = (int16_t)(synth_uniform(&rng) * 1020 - 510);
+        gy[i] = (int16_t)(synth_uniform(&rng) * 1020 - 510);
+        r[i] = (float)(synth_gauss(&rng) * 30);
+        w[i] = (float)synth_uniform(&rng);
+    }
+    m[0] = 1.01f; m[1] = 0.02f; m[2] = 0.7f; m[3] = -0.015f; m[4] = 0.99f; m[5] = -1.3f;
+    m[6] = 1e-4f; m[7] = -2e-4f; m[8] = 1.0f;
+    for (s = 0; s < 3; s++) {
+        const home__refine_kernels *k = home__refine_kernels_for(simds[s]);
+        if (!k) continue;
+        tested++;
+        for (off = 0; off < 3; off++) {
+            const uint8_t *in = src + off;
+            int width = 101 - 2 * off, height = 67 - off, b, dy;
+            ref->blur3(in, 101, d_ref, 101, width, height, t_ref);
+            k->blur3(in, 101, d_simd, 101, width, height, t_simd);
+            CHECK(memcmp(d_ref, d_simd, sizeof d_ref) == 0);
+            ref->downsample(in, 101, d_ref, 50, width / 2, height / 2);
+            k->downsample(in, 101, d_simd, 50, width / 2, height / 2);
+            CHECK(memcmp(d_ref, d_simd, sizeof d_ref) == 0);
+            for (b = 1; b <= 4; b *= 2)
+                for (dy = 0; dy < b; dy++) {
+                    ref->select_keys(in + 101 * (dy + 1), 101, width, b, dy, k_ref, dy > 0);
+                    k->select_keys(in + 101 * (dy + 1), 101, width, b, dy, k_simd, dy > 0);
+                    CHECK(memcmp(k_ref, k_simd, (size_t)width * sizeof *k_ref) == 0);
+                }
+            for (b = 2; b <= 4; b += 2) {
+                /* keys from the rows above (non-negative, < 2^13), an odd count of blocks */
+                static uint16_t c_ref[64], c_simd[64];
+                const int blocks = (width - 1) / b;
+                ref->block_max(k_ref, blocks, b, c_ref);
+                k->block_max(k_ref, blocks, b, c_simd);
+                CHECK(memcmp(c_ref, c_simd, (size_t)blocks * sizeof *c_ref) == 0);
+            }
+            /* 252: a count of whole 4-point lanes that is not one of 8 (AVX2's tail) */
+            ref->warp(m, xs + off, ys + off, 252, in, 101, width, height, o_ref);
+            k->warp(m, xs + off, ys + off, 252, in, 101, width, height, o_simd);
+            CHECK(memcmp(o_ref, o_simd, 252 * sizeof *o_ref) == 0);
+            ref->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_ref);
+            k->warp(m, xs + off, ys + off, 256, in, 101, width, height, o_simd);
+            CHECK(memcmp(o_ref, o_simd, 256 * sizeof *o_ref) == 0);
+            ref->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 1, a_ref);
+            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 1, a_simd);
+            CHECK(memcmp(a_ref, a_simd, sizeof a_ref) == 0);
+            /* J^T W r alone: the same sums, J^T W J left as it was */
+            memset(a_simd, 0x7f, sizeof a_simd);
+            k->accumulate(xs + off, ys + off, gx + off, gy + off, r + off, w + off, 256, aff, 0, a_simd);
+            CHECK(memcmp(a_ref + 36 * 4, a_simd + 36 * 4, 8 * 4 * sizeof *a_ref) == 0);
+            CHECK(a_simd[0] == a_simd[35 * 4 + 3] && a_simd[0] != a_ref[0]);
+            /* gain/bias fit: o_ref holds warped samples (some -1), r doubles as the keep mask */
+            CHECK_EQ_INT(ref->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_ref, a_ref),
+                         k->cauchy_sums(o_ref, r + off, gx + off, 256, 250 - off, 1.07f, -3.5f, 0.11f, w_simd, a_simd));
+            CHECK(memcmp(w_ref, w_simd, 256 * sizeof *w_ref) == 0);
+            CHECK(memcmp(a_ref, a_simd, 20 * sizeof *a_ref) == 0);
+            ref->residuals(o_ref, gy + off, w_ref, 256, 0.93f, 2.25f, o_simd);
+            k->residuals(o_ref, gy + off, w_ref, 256, 0.93f, 2.25f, r_simd);
+            CHECK(memcmp(o_simd, r_simd, 256 * sizeof *r_simd) == 0);
+        }
+        printf("     %s: identical to scalar\n", k->name);
+    }
+    if (!tested) printf("     no SIMD backend compiled in\n");
+}
+
+/* Every compiled-in SIMD backend gives the scalar reference's bytes: odd widths, unaligned source
+ * and destination, inside (steep and near-horizontal) and clamped rows, packed steps; nothing
+ * written past the row. A third of the rows are stabilisation-like (dx in [0, 2.2) px, slopes
+ * up to 0.07 rows per pixel either way, some at the kernels' limits: dx 0, 1, 2 - 2^-16, 2 px,
+ * |dy| 4095..4097 / 2^16), long enough to cross source rows within and between the kernels'
+ * groups of pixels and to reach the plane's right end; some planes end where the array ends. */
+void test_warp_backends_identical(void)
+{
+    static uint8_t src[4 + 97 * 71 * 4], ref[4 + 300 * 4], out[4 + 300 * 4];
+    static const int simds[] = {HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
+    static const int32_t edge_dx[] = {0, 65536, 131071, 131072}, edge_dy[] = {4095, 4096, 4097};
+    synth_rng rng;
+    const uint8_t *plane;
+    int b, trial, k, tested = 0, mismatches = 0, crossing = 0;
+    synth_seed(&rng, 23);
+    for (k = 0; k < (int)sizeof src; k++) src[k] = (uint8_t)(synth_uniform(&rng) * 256);
+    for (b = 0; b < 3; b++) {
+        const home__stab_kernels *kern = home__stab_kernels_for(simds[b]);
+        if (!kern || (b > 0 && kern == home__stab_kernels_for(simds[b - 1]))) continue;
+        tested++;
+        crossing = 0;
+        for (trial = 0; trial < 4500; trial++) {
+            const int w = 2 + (int)(synth_uniform(&rng) * 95), h = 2 + (int)(synth_uniform(&rng) * 69);
+            const int step = trial % 5 == 4 ? 2 : 1, dst_step = step;
+            const ptrdiff_t stride = (ptrdiff_t)w * step + (ptrdiff_t)(synth_uniform(&rng) * 8);
+            int n = 1 + (int)(synth_uniform(&rng) * 299);
+            const int so = trial & 3, dofs = (trial >> 2) & 3;
+            const int inside = trial % 3 != 0, stab = trial % 3 == 2;
+            /* inside rows: start and end well within the plane; others roam outside it */
+            double x0 = inside ? synth_uniform(&rng) * (w - 1.01) : (synth_uniform(&rng) - 0.5) * 3 * w;
+            double y0 = inside ? synth_uniform(&rng) * (h - 1.01) : (synth_uniform(&rng) - 0.5) * 3 * h;
+            double x1 = inside ? synth_uniform(&rng) * (w - 1.01) : (synth_uniform(&rng) - 0.5) * 3 * w;
+            double y1 = inside ? synth_uniform(&rng) * (h - 1.01) : (synth_uniform(&rng) - 0.5) * 3 * h;
+            int32_t dx, dy;
+            /* stabilisation rows are near-horizontal: the kernels' shared-row path */
+            if (inside && trial % 6 == 1) y1 = y0 * (1.0 - 0.02 * synth_uniform(&rng));
+            dx = (int32_t)((x1 - x0) * 65536.0 / (n > 1 ? n - 1 : 1));
+            dy = (int32_t)((y1 - y0) * 65536.0 / (n > 1 ? n - 1 : 1));
+            if (stab) {   /* from near the left end, as long as the row stays inside */
+                const double u = synth_uniform(&rng);
+                x0 = synth_uniform(&rng) * 0.3 * (w - 1.01);
+                dx = u < 0.1 ? edge_dx[trial % 4] : (int32_t)(synth_uniform(&rng) * 2.2 * 65536);
+                dy = u > 0.9 ? edge_dy[trial % 3] : (int32_t)(synth_uniform(&rng) * 0.07 * 65536);
+                if (synth_uniform(&rng) < 0.5) dy = -dy;
+                if (dx > 0 && (w - 1.01 - x0) * 65536.0 / dx + 1 < n) n = (int)((w - 1.01 - x0) * 65536.0 / dx) + 1;
+                if (dy != 0) {
+                    const double room = dy > 0 ? h - 1.01 - y0 : y0;
+                    if (room * 65536.0 / abs(dy) + 1 < n) n = (int)(room * 65536.0 / abs(dy)) + 1;
+                }
+                if (n < 1) n = 1;
+                crossing += n >= 32 && ((int32_t)(y0 * 65536) >> 16) != (((int32_t)(y0 * 65536) + (n - 1) * dy) >> 16);
+            }
+            if ((size_t)(so + stride * h) > sizeof src) continue;
+            /* every seventh plane ends where src ends: a read past its last row (the kernels'
+             * 16-byte windows) leaves the array, which SANITIZE=address builds report */
+            plane = trial % 7 == 5 ? src + sizeof src - ((size_t)stride * (size_t)(h - 1) + (size_t)w * (size_t)step) : src + so;
+            memset(ref, 0x77, sizeof ref);
+            memset(out, 0x77, sizeof out);
+            home__warp_row_c(plane, stride, step, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536),
+                             dx, dy, ref + dofs, dst_step, n);
+            home__warp_row(kern, plane, stride, step, w, h, (int32_t)(x0 * 65536),
+                           (int32_t)(y0 * 65536), dx, dy, out + dofs, dst_step, n);
+            mismatches += memcmp(ref, out, sizeof ref) != 0;
+        }
+        printf("    warp backend %s: %d mismatching rows of 4500 (%d stabilisation-like rows of 32+ pixels "
+               "crossing a source row)\n", kern->name, mismatches, crossing);
+        CHECK(crossing >= 100);
+    }
+    CHECK_EQ_INT(mismatches, 0);
+    CHECK(tested >= 1 || home__stab_kernels_for(HOME_SIMD_AUTO) == &home__stab_kernels_scalar);
+}
+
+/* Rows on a plane's last row pair that run to its right end, the plane ending where its array
+ * ends: the backends' bytes are the reference's, and a read past the plane (a 16-byte window
+ * one column too far) leaves the array, which SANITIZE=address builds report. */
+void test_warp_plane_end(void)
+{
+    static uint8_t src[64 * 4], ref[4 + 128], out[4 + 128];
+    static const int simds[] = {HOME_SIMD_SSE, HOME_SIMD_AVX2, HOME_SIMD_NEON};
+    synth_rng rng;
+    int b, w, k, rows = 0, mismatches = 0;
+    synth_seed(&rng, 29);
+    for (k = 0; k < (int)sizeof src; k++) src[k] = (uint8_t)(synth_uniform(&rng) * 256);
+    for (b = 0; b < 3; b++) {
+        const home__stab_kernels *kern = home__stab_kernels_for(simds[b]);
+        if (!kern || (b > 0 && kern == home__stab_kernels_for(simds[b - 1]))) continue;
+        for (w = 16; w <= 64; w++)
+            for (k = 0; k < 24; k++) {
+                const int h = 2 + k % 3, n = 16 + (int)(synth_uniform(&rng) * 100);
+                const uint8_t *plane = src + sizeof src - (size_t)w * (size_t)h;   /* stride w */
+                const double x1 = w - 1.01 - 0.3 * synth_uniform(&rng), x0 = synth_uniform(&rng) * 0.5 * x1;
+                const double y0 = h - 2 + 0.98 * synth_uniform(&rng);
+                const int32_t dx = (int32_t)((x1 - x0) * 65536.0 / (n - 1));
+                memset(ref, 0x77, sizeof ref);
+                memset(out, 0x77, sizeof out);
+                home__warp_row_c(plane, w, 1, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536), dx, 0, ref + 1, 1, n);
+                home__warp_row(kern, plane, w, 1, w, h, (int32_t)(x0 * 65536), (int32_t)(y0 * 65536), dx,
+                               0, out + 1, 1, n);
+                mismatches += memcmp(ref, out, sizeof ref) != 0;
+                rows++;
+            }
+    }
+    printf("    %d rows at planes' bottom right ends, %d mismatching\n", rows, mismatches);
+    CHECK_EQ_INT(mismatches, 0);
 }

@@ -16,7 +16,7 @@ extern int test_failures;
 
 typedef struct test_case { const char *name; void (*fn)(void); } test_case;
 /* Run the cases named on the command line (all without arguments), print one line each with the
- * prefix, then "N passed, N failed"; returns the exit status. tests/test_runner.c. */
+ * prefix, then "N passed, N failed"; returns the exit status. tests/support/test_runner.c. */
 int test_run(const test_case *cases, size_t n, const char *prefix, int argc, char **argv);
 #define CHECK(cond) do { if (!(cond)) { test_failures++; \
     fprintf(stderr, "    %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
