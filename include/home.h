@@ -98,7 +98,7 @@ typedef struct home_config {
     float threshold_start;    /* first inlier threshold, Hough pixels; halved down to ... */
     float threshold_final;    /* ... this final threshold; paper: 1.0 */
     int min_inliers;          /* fewer final inliers -> failure; paper: 20 (twice this with
-                                 hough_downscale > 1, see the failure rule in README) */
+                                 hough_downscale > 1, see the failure rule at home_match) */
     /* photometric refinement of HOME's H (home_refine() below); refine_levels = 0 turns it off */
     int refine_levels;        /* pyramid levels, 1..HOME_REFINE_MAX_LEVELS; default 3 */
     int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
@@ -139,7 +139,7 @@ int home_default_config(home_config *cfg, int width, int height);
  * the photometric refinement (2048 template points, ending at half resolution:
  * refine_finest_level 1; set it to 0 for full resolution at more cost) restores
  * sub-pixel precision. Motion between
- * the frames should stay under ~30 px at the corners (README, Speed). */
+ * the frames should stay under ~30 px at the corners (docs/speed.md). */
 int home_video_config(home_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range. */

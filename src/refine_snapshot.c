@@ -58,7 +58,7 @@ static int levels_for(const home_config *cfg)
     return l;
 }
 
-static size_t align64(size_t n) { return (n + 63u) & ~(size_t)63u; }
+static size_t align64(size_t n) { return home__align_up(n, HOME__BLOCK_ALIGN); }
 
 static size_t blocks_at(const home_config *cfg, int level)
 {

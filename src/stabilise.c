@@ -21,11 +21,8 @@
 
 /* The smoothing time constant in frames. Automatic (0): with a lookahead of N frames the fixed-lag
  * smoother needs a lag of about twice the time constant to reach the full smoother's response,
- * so N / 2 (at least 3); causal, 15. Measured on bench/stab clips: lookahead 15 with 7.5 halves
- * the jitter of 15. A lookahead of 1-4 is too short to centre even a 3-frame smoother: with 3
- * it left 1.9x / 1.3x / 0.9x / 0.5x the causal jitter (0.82 px), with the causal 15 0.63 /
- * 0.53 / 0.46 / 0.42 px; from 5 on, N / 2 (at least 3) is ahead (lookahead 5: 0.31 px against
- * 0.38). bench/stab/README.md, "Latency". */
+ * so N / 2 (at least 3); causal, and below a lookahead of 5 (too short to centre even a
+ * 3-frame smoother), 15. The measurements: docs/presets.md. */
 #define STAB_CAUSAL_TIME_CONSTANT 15.0
 #define STAB_MIN_CENTRED_LOOKAHEAD 5
 static double stab_time_constant(const home_stab_config *cfg)
@@ -54,18 +51,13 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
     cfg->margin = 0.10f;
     cfg->smoothing = 0.0f;   /* automatic: see home_stab_config */
     cfg->lookahead = 0;
-    /* half the pan at the ends: on the bench clips (lookahead 15) the ends' ITF rose by 0.35 dB
-     * (structured) for 0.006 px more jitter, which counts the easing's curvature; 1 gave
-     * +0.7 dB for +0.023 px */
-    cfg->ease = 0.6f;   /* bench/stab/README.md: the ITF / jitter trade of the eased ends */
-    /* registration at full size up to 960 px wide: on the bench's textureless clips, half size
-     * (640x360 -> 320x180) left 4x the jitter (0.280 vs 0.070 px) for 1.5x the speed */
+    /* the ends ease out of about half the pan (docs/presets.md: the ITF / jitter trade) */
+    cfg->ease = 0.6f;
+    /* registration at full size up to 960 px wide: half size costs textureless clips jitter */
     cfg->downscale = width > 960 ? 2 : 1;
     cfg->min_inliers = 20;
     cfg->refine = 1;
-    /* the refinement ends at half size: on the bench's six clips (lookahead 15) jitter within
-     * 0.005 px and ITF within 0.01 dB of the full-size ending (bench/stab/README.md) for 22 %
-     * fewer instructions per frame */
+    /* the refinement ends at half size: as smooth as the full-size ending, and cheaper */
     cfg->refine_finest_level = 1;
     cfg->hough_downscale = 0;   /* automatic: home_video_config's, a copy ~160 px wide */
     {
@@ -91,9 +83,7 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
     h->keypoints_per_sign = cfg->keypoints_per_sign;
     h->min_inliers = cfg->min_inliers;
     if (!cfg->refine) h->refine_levels = 0;
-    /* a quarter of HOME's 4096: on the six bench clips jitter within 0.001 px and ITF within
-     * 0.003 dB, also with 10 px / 1 degree shake; 15.7 -> 13.0 M instructions per 640x360
-     * frame (2048: 13.9 M; 512: textureless jitter +0.007 px) */
+    /* a quarter of HOME's 4096: as smooth, and cheaper (docs/presets.md) */
     h->refine_points = STAB_REFINE_POINTS;
     /* the path is a similarity: ask for one, so scenes of a few edges, which leave a
      * homography undetermined, still register */
@@ -103,11 +93,8 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
     h->refine_finest_level = cfg->refine ? cfg->refine_finest_level : 0;
     if (cfg->hough_downscale) h->hough_downscale = cfg->hough_downscale;
     h->simd = cfg->simd;
-    /* 88 instead of the video defaults' 120 theta bins: the refinement gives the precision (on
-     * the six bench clips the same jitter and ITF to 0.001 px / 0.01 dB from 120 down to 48
-     * bins); 88 is the fewest that keep at least 90 inliers per frame (min_inliers 20, doubled
-     * for the downscaled Hough image) on six clips with 10 px / 1 degree shake: 80 left 85.
-     * 17.3 -> 15.7 M instructions per 640x360 frame against 120 (bench/stab/README.md) */
+    /* 88 instead of the video defaults' 120 theta bins: the refinement gives the precision, and
+     * 88 is the fewest that keep enough inliers under strong shake (docs/presets.md) */
     bins = cfg->theta_bins ? cfg->theta_bins : STAB_THETA_BINS;
     if (bins < 16 || bins > HOME_MAX_THETA_BINS) return HOME_E_CONFIG;
     h->wrap_band = h->wrap_band * bins / h->theta_bins;

@@ -153,7 +153,7 @@ static int y4m(const char *text, size_t size, int frames)
 }
 #define Y4M(literal, frames) y4m(literal, sizeof literal - 1, frames)
 
-/* name, expected value, expression; the comment column of the README's table */
+/* name, expected value, expression; the comment column of docs/errors.md's table */
 #define BAD_INPUTS(X) \
     /* configuration */ \
     X(config_null, HOME_E_NULL, home_default_config(NULL, W, H)) \

@@ -86,7 +86,7 @@ void test_fails_single_edge(void)
         if (!ctx) { CHECK(0); return; }
         int k;
         /* the defaults are held to the first edge only: at other angles a lone edge crossing
-         * the frame can pass the rule at full size (README, failure rule) */
+         * the frame can pass the rule at full size (home.h, the failure rule at home_match) */
         for (k = 0; k < (preset ? 8 : 1); k++) {
             char what[64];
             sprintf(what, "single edge %d, moved", k);
