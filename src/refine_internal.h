@@ -13,7 +13,7 @@
 #define MIN_POINTS 64       /* fewer usable template points at a level: textureless, decline */
 #define FINEST_MIN_POINTS 512 /* the level the estimate ends at needs this many points, else the
                                  next coarser one is the finest (faint texture: less noise there) */
-#define REGIONS_X 8          /* the identity test's grid of regions (identity_region_share) */
+#define REGIONS_X 8          /* the identity test's grid of regions (refine_static.c) */
 #define REGIONS_Y 6
 #define REGION_TOP 8         /* the identity test's points per region: the strongest blocks */
 #define REGION_CAPACITY (REGIONS_X * REGIONS_Y * REGION_TOP)

@@ -6,10 +6,9 @@
 #include <string.h>
 
 #define REGION_POINTS 3      /* a region with fewer points does not vote */
-#define DECISIVE_RATIO 0.5   /* a region votes when its better cost is at most this share of the
-                                other's */
-#define DECISIVE_GREY 1.0    /* ... and they differ by more than this (grey levels) per point */
-#define MIN_VOTES 6          /* fewer voting regions: no decision (share 0) */
+#define DECISIVE_RATIO 0.5   /* a clear vote: the better cost at most this share of the other */
+#define DECISIVE_GREY 1.0    /* ... and the two apart by more than this squared per point */
+#define MIN_VOTES 6          /* fewer clear votes: no decision (clear_share 0) */
 
 /* Share of the frame's regions (a REGIONS_X x REGIONS_Y grid; those with at least REGION_POINTS
  * of the region points vote) whose points the identity explains better than h (pixels) does:
@@ -74,7 +73,7 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
         votes++;
         wins += cost_i < cost_h;
         /* a clear vote: at most half the other's cost, and more than a grey level per point
-         * apart (near the home__refine_identity, or on flat regions, the costs tie) */
+         * apart (near the identity, or on flat regions, the costs tie) */
         if ((cost_i < cost_h ? cost_i : cost_h) >
                 DECISIVE_RATIO * (cost_i < cost_h ? cost_h : cost_i) ||
             fabs(cost_i - cost_h) <= DECISIVE_GREY * DECISIVE_GREY * count[r])
