@@ -36,18 +36,20 @@
 #include <math.h>
 #include <string.h>
 
-#define STATIC_SHARE 0.5     /* the identity replaces a motion that wins fewer regions */
-#define TWO_MOTIONS_SHARE 0.1 /* ... and a motion the identity contests this much is not ok */
+#define STATIC_SHARE 0.5     /* the identity replaces a motion when it wins this share of the
+                                regions (or of the clearly decided ones) */
+#define TWO_MOTIONS_SHARE 0.1 /* ... and a motion is not ok when the identity clearly wins this
+                                 share of the clearly decided regions */
 #define IDENTITY_SIGMAS 2.0  /* a motion within this many predicted errors of the identity is it */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
                                  without HOME's confirmation, the tuning set's wrong refined
                                  answers (few edges) predicted 0.44-0.66 px, 95 % of the right
                                  ones less than 0.4 */
-#define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
-                                     within 3 sigma_px or this */
 #define VOUCH_SHARE 0.9      /* ... and, against HOME's estimate or with none, with this share
                                 of its points within 3 robust sigmas */
+#define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
+                                     within 3 sigma_px or this */
 
 /* Largest distance of the image corners under two pixel homographies (NaN: infinitely far). */
 static double corner_distance(const home_context *ctx, const double *h1, const double *h2)
