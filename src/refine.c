@@ -157,23 +157,19 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         trial.ok = 0;
         trial.failure = HOME_FAIL_INCONSISTENT;
     }
-    /* a motion its own predicted error cannot tell from the identity is no evidence of one */
-    if (trial.ok && trial.model != HOME_MODEL_IDENTITY &&
-        isfinite(trial.sigma_px) &&
-        corner_distance(ctx, trial.H, home__refine_identity) <= IDENTITY_SIGMAS * trial.sigma_px) {
-        memcpy(trial.H, home__refine_identity, sizeof trial.H);
-        trial.model = HOME_MODEL_IDENTITY;
-        trial.refine_status = HOME_REFINE_STATIC;
-    }
-    /* a motion the static background does not share is the moving objects' */
-    if (trial.ok && trial.model != HOME_MODEL_IDENTITY &&
-        ((share = home__refine_identity_share(ctx, slot, trial.H, &clear_share)) >= STATIC_SHARE ||
-         clear_share >= TWO_MOTIONS_SHARE)) {
-        if (share >= STATIC_SHARE || clear_share >= STATIC_SHARE) {
+    /* a motion its own predicted error cannot tell from the identity is no evidence of one; a
+     * motion the static background does not share is the moving objects' */
+    if (trial.ok && trial.model != HOME_MODEL_IDENTITY) {
+        const double d_identity = corner_distance(ctx, trial.H, home__refine_identity);
+        const int within_sigma =
+            isfinite(trial.sigma_px) && d_identity <= IDENTITY_SIGMAS * trial.sigma_px;
+        share = clear_share = 0.0;
+        if (!within_sigma) share = home__refine_identity_share(ctx, slot, trial.H, &clear_share);
+        if (within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE) {
             memcpy(trial.H, home__refine_identity, sizeof trial.H);
             trial.model = HOME_MODEL_IDENTITY;
             trial.refine_status = HOME_REFINE_STATIC;
-        } else {
+        } else if (clear_share >= TWO_MOTIONS_SHARE) {
             trial.ok = 0;
             trial.failure = HOME_FAIL_INCONSISTENT;
         }
