@@ -217,7 +217,7 @@ int main(int argc, char **argv)
 
         home_stab_config cfg;
         int st = home_stab_default_config(&cfg, (int)width, (int)height);
-        cfg.margin = o.margin;
+        cfg.margin_x = cfg.margin_y = o.margin;
         cfg.smoothing = o.smoothing;
         cfg.lookahead = o.lookahead;
         cfg.clock = eis_now_ms;

@@ -390,7 +390,7 @@ int main(int argc, char **argv)
                 o.device, cam.width, cam.height, fourcc_name(cam.fourcc, name),
                 cam.mplane ? "multi-planar" : "single-planar", cam.n_planes, cam.bytesperline[0], cam.n_buffers);
     status = home_stab_default_config(&cfg, cam.width, cam.height);
-    cfg.margin = o.margin;
+    cfg.margin_x = cfg.margin_y = o.margin;
     cfg.smoothing = o.smoothing;
     cfg.lookahead = o.lookahead;
     cfg.clock = eis_now_ms;

@@ -27,6 +27,9 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: home-stab [options] IN.y4m OUT.y4m      (- for stdin / stdout)\n"
             "  --margin F        crop margin per side, fraction of the frame (default 0.10)\n"
+            "  --margin-x F, --margin-y F  the left/right margin (fraction of the width) and the\n"
+            "                    top/bottom one (of the height) apart; unequal margins change the\n"
+            "                    picture's aspect\n"
             "  --smoothing F     path smoothing time constant, frames (default: lookahead / 2, at\n"
             "                    least 3; 15 with a lookahead below 5 or none)\n"
             "  --lookahead N     frames of latency for fixed-lag smoothing (default 0)\n"
@@ -96,8 +99,8 @@ typedef struct app {
 
 static const char *status_name(int s)
 {
-    static const char *names[] = {"first", "ok", "failed", "implausible"};
-    return s >= 0 && s < 4 ? names[s] : "?";
+    static const char *names[] = {"first", "ok", "failed", "implausible", "cut"};
+    return s >= 0 && s < 5 ? names[s] : "?";
 }
 
 /* Copy the planes of a (w x h) frame into the left or right half of a 2w-wide frame. */
@@ -211,7 +214,7 @@ int main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
     home_stab_config cfg;
-    double margin = 0.10, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0,
+    double margin = 0.10, margin_x = -1, margin_y = -1, smoothing = 0, lookahead = 0, downscale = 0, keypoints = 500, hough_ds = 0,
            theta_bins = 0, ease = -1, refine_finest = -1, threads = 1;
     double t_start, ms_reg = 0, last_report;
     app ap;
@@ -221,7 +224,7 @@ int main(int argc, char **argv)
     FILE *in;
     char err[256];
     int i, status, rc = 0, got, refine = 1;
-    long frames = 0, failed = 0;
+    long frames = 0, failed = 0, cuts = 0;
     size_t need;
 
     memset(&ap, 0, sizeof ap);
@@ -242,6 +245,8 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--csv")) { csv_path = argv[++i]; continue; }
         if (!strcmp(a, "--plot")) { plot_path = argv[++i]; continue; }
         if (!strcmp(a, "--margin")) { target = &margin; lo = 0; hi = 0.4; }
+        else if (!strcmp(a, "--margin-x")) { target = &margin_x; lo = 0; hi = 0.4; }
+        else if (!strcmp(a, "--margin-y")) { target = &margin_y; lo = 0; hi = 0.4; }
         else if (!strcmp(a, "--smoothing")) { target = &smoothing; lo = 1; hi = 1000; }
         else if (!strcmp(a, "--lookahead")) { target = &lookahead; lo = 0; hi = HOME_STAB_MAX_LOOKAHEAD; }
         else if (!strcmp(a, "--ease")) { target = &ease; lo = 0; hi = 1; }
@@ -265,7 +270,8 @@ int main(int argc, char **argv)
         return 2;
     }
     status = home_stab_default_config(&cfg, ap.info.width, ap.info.height);
-    cfg.margin = (float)margin;
+    cfg.margin_x = (float)(margin_x >= 0 ? margin_x : margin);
+    cfg.margin_y = (float)(margin_y >= 0 ? margin_y : margin);
     cfg.smoothing = (float)smoothing;
     cfg.lookahead = (int)lookahead;
     if (ease >= 0) cfg.ease = (float)ease;
@@ -335,6 +341,7 @@ int main(int argc, char **argv)
         ap.reg[frames % ap.ring_len].model = o.reg.model;
         ap.reg[frames % ap.ring_len].sigma_px = o.reg.sigma_px;
         failed += o.newest_status == HOME_STAB_MOTION_FAILED || o.newest_status == HOME_STAB_MOTION_IMPLAUSIBLE;
+        cuts += o.newest_status == HOME_STAB_MOTION_CUT;
         ms_reg += o.ms_register;
         frames++;
         if (o.ready && emit_output(&ap, &o)) { rc = 2; break; }
@@ -356,9 +363,11 @@ int main(int argc, char **argv)
     if (fflush(ap.out) != 0) { fprintf(stderr, "home-stab: write error\n"); rc = 2; }
     if (!ap.quiet)
         fprintf(stderr, "home-stab: %ld frames in, %ld out, %.1f fps, register %.1f ms/frame, "
-                        "warp %.1f ms/frame, %ld held (registration failed or implausible)\n",
+                        "warp %.1f ms/frame, %ld held (registration failed or implausible), "
+                        "%ld scene cuts\n",
                 frames, ap.written, frames * 1e3 / (now_ms(NULL) - t_start + 1e-9),
-                frames ? ms_reg / frames : 0.0, ap.written ? ap.ms_warp / ap.written : 0.0, failed);
+                frames ? ms_reg / frames : 0.0, ap.written ? ap.ms_warp / ap.written : 0.0, failed,
+                cuts);
     if (plot_path && stab_plot_write(&ap.plot, plot_path, ap.info.width, ap.info.height)) {
         fprintf(stderr, "home-stab: cannot write %s\n", plot_path);
         rc = 2;

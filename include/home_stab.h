@@ -7,7 +7,7 @@
  * (each frame's measurement noise grows with the registration's predicted error sigma_px, so an
  * uncertain motion pulls the path less; a static scene registers as exactly no motion) and, with a
  * lookahead of N frames, a fixed-lag Rauch-Tung-Striebel smoother over those N frames; and returns
- * the warp that shows the smoothed camera through a crop window (margin m on each side, scaled to
+ * the warp that shows the smoothed camera through a crop window (margins on each side, scaled to
  * fill the frame). The correction is shrunk towards identity whenever the window would leave the
  * frame, so the output never shows pixels from outside the input. A failed or implausible
  * registration is taken as "no motion": the path holds and the correction decays smoothly towards
@@ -58,7 +58,11 @@ typedef struct home_stab_image {
 
 typedef struct home_stab_config {
     int width, height;        /* frame size (luma) */
-    float margin;             /* crop margin on each side, fraction of the side; 0.10 */
+    float margin_x, margin_y; /* crop margin on the left and right, fraction of the width, and
+                                 on the top and bottom, fraction of the height; 0.10 each. The
+                                 window is scaled to fill the frame: unequal margins change the
+                                 picture's aspect (e.g. to spend the spare height of 4:3 content
+                                 framed in 16:9) */
     float smoothing;          /* path smoothing time constant in frames (Kalman bandwidth
                                  1/smoothing per frame); larger = steadier, more crop used;
                                  0 = automatic: lookahead / 2 (at least 3); with a
@@ -101,7 +105,8 @@ enum home_stab_motion_status {
     HOME_STAB_MOTION_FIRST = 0, /* first frame: nothing to register to */
     HOME_STAB_MOTION_OK,        /* HOME's H, fitted by a similarity, is the motion */
     HOME_STAB_MOTION_FAILED,    /* HOME found no trustworthy H: held (no motion) */
-    HOME_STAB_MOTION_IMPLAUSIBLE /* H outside the configured limits: held (no motion) */
+    HOME_STAB_MOTION_IMPLAUSIBLE, /* H outside the configured limits: held (no motion) */
+    HOME_STAB_MOTION_CUT        /* a scene cut (or home_stab_cut()): the path restarts here */
 };
 
 /* A similarity about the image centre c: p -> exp(log_scale) R(angle) (p - c) + c + (tx, ty). */
@@ -126,7 +131,7 @@ typedef struct home_stab_output {
 
 typedef struct home_stab home_stab;
 
-/* Defaults for a width x height stream: margin 0.10, automatic smoothing, lookahead 0, ease 0.6,
+/* Defaults for a width x height stream: margins 0.10, automatic smoothing, lookahead 0, ease 0.6,
  * downscale 2 for frames wider than 960 px (else 1), then home_video_config()'s choices for the
  * registration image (500 keypoints per sign, automatic hough_downscale: Hough on a copy about
  * 160 px wide) with 88 theta bins, a theta window from max_rotation, refinement on with 1024
@@ -151,8 +156,14 @@ int home_stab_push(home_stab *stab, const home_stab_image *frame, home_stab_outp
 /* End of stream: report the next queued frame (out->ready = 0 once none is left). */
 int home_stab_flush(home_stab *stab, home_stab_output *out);
 
-/* Forget the path and queued frames (e.g. after a scene cut or capture restart). */
+/* Forget the path and queued frames (e.g. after a capture restart): frames still queued are
+ * dropped. */
 int home_stab_reset(home_stab *stab);
+
+/* The next frame pushed starts a new scene, as a detected cut does (see the top of this file):
+ * for a caller that knows of a cut or a discontinuity (an edit, a stream switch). Nothing
+ * queued is lost. */
+int home_stab_cut(home_stab *stab);
 
 /* Warp src into dst (same format and size) by the affine map warp (output luma pixel -> source
  * luma pixel), bilinear in fixed point, edges replicated. HOME_E_CONFIG when the map is not

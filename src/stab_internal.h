@@ -17,6 +17,10 @@ void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t s
                     int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, uint8_t *dst,
                     int dst_step, int n);
 
+/* Scene cuts are told by a coarse thumbnail of each frame: HOME__STAB_THUMB_SIDE^2 cell means. */
+#define HOME__STAB_THUMB_SIDE 16
+#define HOME__STAB_THUMB_CELLS (HOME__STAB_THUMB_SIDE * HOME__STAB_THUMB_SIDE)
+
 /* One frame of path history. Path components are normalised to pixels (angle and log scale
  * times the half diagonal) so that one filter covariance serves all four of them. */
 typedef struct stab_slot {
@@ -26,6 +30,8 @@ typedef struct stab_slot {
     home_stab_sim raw;            /* camera path: frame 0 -> this frame */
     double xf[4][2], xp[4][2];    /* filtered / predicted (position, velocity) per component */
     double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
+    int smoothed_ready;           /* its segment has ended: `smoothed` is its final path */
+    home_stab_sim smoothed;
 } stab_slot;
 
 struct home_stab {
@@ -41,7 +47,11 @@ struct home_stab {
     stab_slot *ring;              /* 2 lookahead + 1 slots, frame n in ring[n % len] */
     int ring_len;
     long pushed, emitted;
-    int tail;                     /* flush has appended the mirrored frames after the last one */
+    long first;                   /* first frame of the current segment (a cut starts one) */
+    int tail;                     /* flush has ended the segment at the last frame pushed */
+    int cut_requested;            /* home_stab_cut(): the next frame starts a segment */
+    int thumb_index;              /* thumb[thumb_index]: the newest frame's */
+    float thumb[2][HOME__STAB_THUMB_CELLS]; /* coarse luma of the last two frames (cuts) */
     double q, r, norm;            /* process / measurement noise, px per radian or log-scale */
 };
 
@@ -62,8 +72,12 @@ double home__stab_fit_similarity(const home_stab *st, const double *h, home_stab
 void home__stab_path_components(const home_stab *st, const home_stab_sim *s, double *z);
 void home__stab_kalman_step(const home_stab *st, const stab_slot *prev, stab_slot *cur,
                             const double *z);
-void home__stab_refilter_mirrored_start(const home_stab *st, long last);
-void home__stab_append_mirrored_end(home_stab *st, long last);
+void home__stab_refilter_mirrored_start(const home_stab *st, long first, long last);
+void home__stab_end_segment(home_stab *st, long last);
 home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last);
+
+/* stab_cut.c */
+void home__stab_thumbnail(const uint8_t *luma, ptrdiff_t stride, int w, int h, float *thumb);
+double home__stab_thumb_similarity(const float *a, const float *b, int max_shift_cells);
 
 #endif

@@ -69,58 +69,76 @@ static void path_trend(const home_stab *st, long a, long b, double *v)
     for (c = 0; c < 4; c++) v[c] = stt > 0.0 ? sz[c] / stt : 0.0;
 }
 
-/* The measurement taken for frame t outside 0..last: the frame t is reflected to (again and
- * again for streams shorter than the lookahead), plus the kept trend over the distance. */
-static void mirrored_measurement(const home_stab *st, long t, long last, const double *trend,
-                                 double *z)
+/* The measurement taken for frame t outside the segment first..last: the frame t is reflected
+ * to (again and again for segments shorter than the lookahead), plus the kept trend over the
+ * distance. */
+static void mirrored_measurement(const home_stab *st, long t, long first, long last,
+                                 const double *trend, double *z)
 {
     const double keep = 1.0 - st->cfg.ease;
     long r = t;
     int c;
-    while (last > 0 && (r < 0 || r > last)) r = r < 0 ? -r : 2 * last - r;
-    if (last == 0) r = 0;
+    while (last > first && (r < first || r > last)) r = r < first ? 2 * first - r : 2 * last - r;
+    if (last == first) r = first;
     home__stab_path_components(st, &slot_of(st, r)->raw, z);
     for (c = 0; c < 4; c++) z[c] += keep * trend[c] * (double)(t - r);
 }
 
-/* Re-run the filter over frames 0..last (all in the ring) after the mirrored frames -k..-1,
- * k = min(lookahead, last). */
-void home__stab_refilter_mirrored_start(const home_stab *st, long last)
+/* Re-run the filter over the segment's frames first..last (all in the ring) after the mirrored
+ * frames first-k..first-1, k = min(lookahead, last - first). */
+void home__stab_refilter_mirrored_start(const home_stab *st, long first, long last)
 {
-    const long k = last < st->cfg.lookahead ? last : st->cfg.lookahead;
+    const long k = last - first < st->cfg.lookahead ? last - first : st->cfg.lookahead;
     stab_slot v[2];
     const stab_slot *prev = NULL;
     double trend[4], z[4];
     long i;
     if (k <= 0) return;
     v[0].weight = v[1].weight = 1.0;
-    path_trend(st, 0, k, trend);
-    for (i = -k; i <= last; i++) {
-        stab_slot *cur = i < 0 ? &v[i & 1] : slot_of(st, i);
-        if (i < 0) mirrored_measurement(st, i, last, trend, z);
+    path_trend(st, first, first + k, trend);
+    for (i = first - k; i <= last; i++) {
+        stab_slot *cur = i < first ? &v[(first - i) & 1] : slot_of(st, i);
+        if (i < first) mirrored_measurement(st, i, first, last, trend, z);
         else home__stab_path_components(st, &cur->raw, z);
         home__stab_kalman_step(st, prev, cur, z);
         prev = cur;
     }
 }
 
-/* Append the mirrored frames last+1..last+lookahead. The ring has 2 lookahead + 1 slots: frame
- * last+i takes the slot of frame last+i-ring_len, older than every frame mirrored or still due. */
-void home__stab_append_mirrored_end(home_stab *st, long last)
+/* Append the mirrored frames last+1..last+lookahead to the segment first..last. The ring has
+ * 2 lookahead + 1 slots: frame last+i takes the slot of frame last+i-ring_len, older than every
+ * frame mirrored or still due. */
+static void append_mirrored_end(home_stab *st, long first, long last)
 {
-    const long k = last < st->cfg.lookahead ? last : st->cfg.lookahead;
+    const long k = last - first < st->cfg.lookahead ? last - first : st->cfg.lookahead;
     double trend[4], z[4];
     long i;
     path_trend(st, last - k, last, trend);
     for (i = 1; i <= st->cfg.lookahead; i++) {
         stab_slot *cur = slot_of(st, last + i);
-        mirrored_measurement(st, last + i, last, trend, z);
+        mirrored_measurement(st, last + i, first, last, trend, z);
         cur->frame = last + i;
         cur->status = HOME_STAB_MOTION_OK;
         cur->weight = 1.0;
+        cur->smoothed_ready = 0;
         home__stab_kalman_step(st, slot_of(st, last + i - 1), cur, z);
     }
-    st->tail = 1;
+}
+
+/* The segment ends with frame last (a scene cut follows, or the stream ends): every frame still
+ * due is smoothed now over the mirrored end, as a stream ending there would be, and keeps its
+ * smoothed path, so the frames after a cut can take the ring without touching them. */
+void home__stab_end_segment(home_stab *st, long last)
+{
+    long m;
+    if (last - st->first < st->cfg.lookahead)
+        home__stab_refilter_mirrored_start(st, st->first, last);
+    append_mirrored_end(st, st->first, last);
+    for (m = st->emitted; m <= last; m++) {
+        stab_slot *slot = slot_of(st, m);
+        slot->smoothed = home__stab_smoothed_path(st, m, m + st->cfg.lookahead);
+        slot->smoothed_ready = 1;
+    }
 }
 
 /* Fixed-lag RTS smoothing: the estimate of frame m's path given every frame up to last. */

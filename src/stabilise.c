@@ -18,6 +18,10 @@
  * pulls the path less; beyond STAB_MAX_SIGMA_PX the frame holds the path. */
 #define STAB_SIGMA_REF_PX 0.5
 #define STAB_MAX_SIGMA_PX 4.0
+/* A scene cut: thumbnails correlating below STAB_CUT_SIMILARITY at every shift of up to
+ * max_shift (at most STAB_CUT_MAX_SHIFT_CELLS cells, so that most cells are compared) */
+#define STAB_CUT_SIMILARITY 0.5
+#define STAB_CUT_MAX_SHIFT_CELLS 4
 
 /* The smoothing time constant in frames. Automatic (0): with a lookahead of N frames the fixed-lag
  * smoother needs a lag of about twice the time constant to reach the full smoother's response,
@@ -48,7 +52,7 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
     memset(cfg, 0, sizeof *cfg);
     cfg->width = width;
     cfg->height = height;
-    cfg->margin = 0.10f;
+    cfg->margin_x = cfg->margin_y = 0.10f;
     cfg->smoothing = 0.0f;   /* automatic: see home_stab_config */
     cfg->lookahead = 0;
     /* the ends ease out of about half the pan (docs/presets.md: the ITF / jitter trade) */
@@ -114,7 +118,7 @@ int home_stab_validate_config(const home_stab_config *cfg)
     if (cfg->width < HOME_MIN_SIDE || cfg->height < HOME_MIN_SIDE || cfg->width > HOME_MAX_SIDE ||
         cfg->height > HOME_MAX_SIDE || cfg->width % 2 || cfg->height % 2)
         return HOME_E_SIZE;
-    if (!is_finite_in(cfg->margin, 0.0, 0.4) ||
+    if (!is_finite_in(cfg->margin_x, 0.0, 0.4) || !is_finite_in(cfg->margin_y, 0.0, 0.4) ||
         !(cfg->smoothing == 0.0f || is_finite_in(cfg->smoothing, 1.0, 1000.0)) ||
         cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD ||
         !is_finite_in(cfg->ease, 0.0, 1.0) || (cfg->refine != 0 && cfg->refine != 1) ||
@@ -200,9 +204,29 @@ int home_stab_reset(home_stab *st)
 {
     if (!st) return HOME_E_NULL;
     if (st->magic != STAB_MAGIC) return HOME_E_STATE;
-    st->pushed = st->emitted = 0;
-    st->tail = 0;
+    st->pushed = st->emitted = st->first = 0;
+    st->tail = st->cut_requested = 0;
     return HOME_OK;
+}
+
+int home_stab_cut(home_stab *st)
+{
+    if (!st) return HOME_E_NULL;
+    if (st->magic != STAB_MAGIC) return HOME_E_STATE;
+    st->cut_requested = 1;
+    return HOME_OK;
+}
+
+/* A frame HOME could not register to its predecessor starts a new scene when its coarse luma is
+ * unlike the predecessor's at every plausible shift, gain and offset (tuned on the tuning half
+ * of bench/stab's real-world set: docs/stabiliser.md). */
+static int is_scene_cut(const home_stab *st)
+{
+    const int max_shift_cells = (int)ceil(st->cfg.max_shift * HOME__STAB_THUMB_SIDE);
+    return home__stab_thumb_similarity(st->thumb[st->thumb_index ^ 1], st->thumb[st->thumb_index],
+                                       max_shift_cells < STAB_CUT_MAX_SHIFT_CELLS
+                                           ? max_shift_cells : STAB_CUT_MAX_SHIFT_CELLS)
+           < STAB_CUT_SIMILARITY;
 }
 
 /* Box-average the frame's luma into st->small; returns the image registration reads. */
@@ -239,17 +263,17 @@ static const uint8_t *registration_luma(home_stab *st, const home_stab_image *im
 /* output pixel -> input pixel for a correction (virtual camera -> real camera) share k */
 static void crop_warp(const home_stab *st, const home_stab_sim *corr, double k, double *m)
 {
-    const double z = 1.0 - 2.0 * st->cfg.margin;
+    const double zx = 1.0 - 2.0 * st->cfg.margin_x, zy = 1.0 - 2.0 * st->cfg.margin_y;
     const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
     home_stab_sim part = home__stab_sim_scaled(corr, k);
     double d[9];
     int i;
     home_stab_sim_to_matrix(&part, st->cfg.width, st->cfg.height, d);
-    /* d after the zoom q -> c + z (q - c) */
+    /* d after the zoom q -> c + diag(zx, zy) (q - c) */
     for (i = 0; i < 2; i++) {
-        m[3 * i + 2] = d[3 * i + 0] * cx * (1 - z) + d[3 * i + 1] * cy * (1 - z) + d[3 * i + 2];
-        m[3 * i + 0] = d[3 * i + 0] * z;
-        m[3 * i + 1] = d[3 * i + 1] * z;
+        m[3 * i + 2] = d[3 * i + 0] * cx * (1 - zx) + d[3 * i + 1] * cy * (1 - zy) + d[3 * i + 2];
+        m[3 * i + 0] = d[3 * i + 0] * zx;
+        m[3 * i + 1] = d[3 * i + 1] * zy;
     }
     m[6] = 0; m[7] = 0; m[8] = 1;
 }
@@ -277,7 +301,7 @@ static void emit(home_stab *st, long last, home_stab_output *out)
     out->frame = m;
     out->raw = slot->raw;
     out->motion_status = slot->status;
-    out->smooth = home__stab_smoothed_path(st, m, last);
+    out->smooth = slot->smoothed_ready ? slot->smoothed : home__stab_smoothed_path(st, m, last);
     /* the real camera seen from the virtual (smoothed) one: raw after smooth^-1 */
     inv_smooth = home__stab_sim_inverse(&out->smooth);
     corr = home__stab_sim_compose(&slot->raw, &inv_smooth);
@@ -346,13 +370,26 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     swap = st->feat[0];
     st->feat[0] = st->feat[1];
     st->feat[1] = swap;
+    st->thumb_index ^= 1;
+    home__stab_thumbnail(luma, stride, st->small_w, st->small_h, st->thumb[st->thumb_index]);
+    if (n > 0 && (st->cut_requested ||
+                  (out->newest_status != HOME_STAB_MOTION_OK && is_scene_cut(st)))) {
+        /* a new scene: the frames still due are smoothed as if the stream ended before it, and
+         * its path starts afresh, so no smoothing window and no motion spans the cut */
+        if (st->emitted < n) home__stab_end_segment(st, n - 1);
+        st->first = n;
+        out->newest_status = HOME_STAB_MOTION_CUT;
+        weight = 1.0;   /* as a stream's first frame */
+    }
+    st->cut_requested = 0;
     if (st->cfg.clock) out->ms_register = st->cfg.clock(st->cfg.clock_user) - t0;
 
     slot = slot_of(st, n);
     slot->frame = n;
     slot->status = out->newest_status;
     slot->weight = weight;
-    if (n == 0) {
+    slot->smoothed_ready = 0;
+    if (n == st->first) {
         memset(&slot->raw, 0, sizeof slot->raw);
         home__stab_path_components(st, &slot->raw, z);
         home__stab_kalman_step(st, NULL, slot, z);
@@ -364,7 +401,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     }
     st->pushed = n + 1;
     st->tail = 0;
-    if (n == st->cfg.lookahead) home__stab_refilter_mirrored_start(st, n);
+    if (n - st->first == st->cfg.lookahead) home__stab_refilter_mirrored_start(st, st->first, n);
     if (n - st->emitted >= st->cfg.lookahead) emit(st, n, out);
     return HOME_OK;
 }
@@ -376,9 +413,8 @@ int home_stab_flush(home_stab *st, home_stab_output *out)
     memset(out, 0, sizeof *out);
     if (st->emitted >= st->pushed) return HOME_OK;
     if (!st->tail) {
-        if (st->pushed - 1 < st->cfg.lookahead)
-            home__stab_refilter_mirrored_start(st, st->pushed - 1);
-        home__stab_append_mirrored_end(st, st->pushed - 1);
+        home__stab_end_segment(st, st->pushed - 1);
+        st->tail = 1;
     }
     emit(st, st->emitted + st->cfg.lookahead, out);
     return HOME_OK;

@@ -251,7 +251,8 @@ static int y4m(const char *text, size_t size, int frames)
     /* stabiliser (home_stab_*) */ \
     X(stab_config_null, HOME_E_NULL, home_stab_default_config(NULL, W, H)) \
     X(stab_odd_width, HOME_E_SIZE, (sbad.width = W + 1, home_stab_validate_config(&sbad))) \
-    X(stab_margin_nan, HOME_E_CONFIG, (sbad.margin = (float)NAN, home_stab_validate_config(&sbad))) \
+    X(stab_margin_x_nan, HOME_E_CONFIG, (sbad.margin_x = (float)NAN, home_stab_validate_config(&sbad))) \
+    X(stab_margin_y_above_0_4, HOME_E_CONFIG, (sbad.margin_y = 0.41f, home_stab_validate_config(&sbad))) \
     X(stab_theta_bins_below_16, HOME_E_CONFIG, (sbad.theta_bins = 15, home_stab_validate_config(&sbad))) \
     X(stab_refine_finest_level_2, HOME_E_CONFIG, (sbad.refine_finest_level = 2, home_stab_validate_config(&sbad))) \
     X(stab_lookahead_above_max, HOME_E_CONFIG, (sbad.lookahead = HOME_STAB_MAX_LOOKAHEAD + 1, home_stab_validate_config(&sbad))) \
@@ -264,6 +265,8 @@ static int y4m(const char *text, size_t size, int frames)
     X(stab_push_missing_chroma_plane, HOME_E_NULL, push_i420(1)) \
     X(stab_push_uninitialised, HOME_E_STATE, home_stab_push((home_stab *)(void *)junk.bytes, &sframe, &sout)) \
     X(stab_flush_null_output, HOME_E_NULL, home_stab_flush(stab, NULL)) \
+    X(stab_cut_null, HOME_E_NULL, home_stab_cut(NULL)) \
+    X(stab_cut_uninitialised, HOME_E_STATE, home_stab_cut((home_stab *)(void *)junk.bytes)) \
     X(stab_warp_projective, HOME_E_CONFIG, (warp_m[6] = 1e-3, home_stab_warp(warp_m, &sframe, &sdst))) \
     X(stab_warp_nan, HOME_E_CONFIG, (warp_m[2] = NAN, home_stab_warp(warp_m, &sframe, &sdst))) \
     X(stab_warp_far_outside, HOME_E_CONFIG, (warp_m[2] = 10.0 * W, home_stab_warp(warp_m, &sframe, &sdst))) \

@@ -193,6 +193,12 @@ static void job_stab_push(void)
     home_stab_push(s_stab, &s_frame_a, &s_out);
     home_stab_push(s_stab, &s_frame_b, &s_out);
 }
+static void job_stab_push_cut(void)
+{
+    home_stab_push(s_stab, &s_frame_a, &s_out);
+    home_stab_cut(s_stab);
+    home_stab_push(s_stab, &s_frame_b, &s_out);
+}
 static void job_stab_flush(void) { home_stab_flush(s_stab, &s_out); }
 static void job_stab_warp(void)
 {
@@ -220,6 +226,7 @@ void test_stack_painted(void)
         {"home_model_name, home_failure_name, home_refine_status_name", job_names},
         {"home_simd_backend", job_simd_backend}, {"home_refine", job_refine},
         {"home_stab_init", job_stab_init}, {"home_stab_push (2 frames)", job_stab_push},
+        {"home_stab_push (a frame, a cut, a frame)", job_stab_push_cut},
         {"home_stab_flush", job_stab_flush}, {"home_stab_warp", job_stab_warp},
         {"home_stab_warp_rows", job_stab_warp_rows},
     };

@@ -599,7 +599,8 @@ static void test_api_contract(void)
     CHECK_EQ_INT(home_stab_init(&st, &cfg, base + 1, size + 16, NULL), HOME_E_ARENA_ALIGN);
     CHECK_EQ_INT(home_stab_init(&st, NULL, base, size, NULL), HOME_E_NULL);
     bad = cfg; bad.width = CW + 1; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_SIZE);
-    bad = cfg; bad.margin = 0.5f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.margin_x = 0.5f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
+    bad = cfg; bad.margin_y = -0.1f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.smoothing = NAN; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.lookahead = HOME_STAB_MAX_LOOKAHEAD + 1; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
     bad = cfg; bad.ease = 1.5f; CHECK_EQ_INT(home_stab_validate_config(&bad), HOME_E_CONFIG);
@@ -664,11 +665,133 @@ static void test_static_camera_moving_object(void)
     CHECK_LT(worst, 0.05);
 }
 
+/* ---- scene cuts ---- */
+
+/* Stabilise frames[0..n) (I420 buffers) with the given lookahead, calling home_stab_cut() before
+ * frame cut_call (-1: never); the warp and the newest status per frame. 0 unless every frame
+ * came out once, in order. */
+static int run_frames(int lookahead, uint8_t *const *frames, int n, int cut_call,
+                      double (*warp)[9], int *status)
+{
+    home_stab *st = make_stab(lookahead, 1, 0);
+    home_stab_output o;
+    home_stab_image im;
+    int t, next = 0, ok = st != NULL;
+    for (t = 0; ok && t < n; t++) {
+        if (t == cut_call && home_stab_cut(st) != HOME_OK) ok = 0;
+        grey_image(frames[t], &im);
+        if (home_stab_push(st, &im, &o) != HOME_OK) { ok = 0; break; }
+        status[t] = o.newest_status;
+        if (!o.ready) continue;
+        ok &= o.frame == next;
+        memcpy(warp[next++], o.warp, sizeof o.warp);
+    }
+    while (ok && home_stab_flush(st, &o) == HOME_OK && o.ready) {
+        ok &= o.frame == next;
+        memcpy(warp[next++], o.warp, sizeof o.warp);
+    }
+    return ok && next == n;
+}
+
+#define CUT_AT 30
+
+/* The stream cut at CUT_AT must give, byte for byte, the warps of its two parts stabilised as
+ * separate streams: no smoothing window spans the cut and no frame after it is warped by the
+ * motion before it (nor one before it by the motion after). */
+static int cut_matches_parts(int lookahead, uint8_t *const *frames, int cut_call, int *status)
+{
+    static double whole[CLIP_FRAMES][9], part[CLIP_FRAMES][9];
+    static int part_status[CLIP_FRAMES];
+    int ok = run_frames(lookahead, frames, CLIP_FRAMES, cut_call, whole, status);
+    ok &= run_frames(lookahead, frames, CUT_AT, -1, part, part_status);
+    ok &= run_frames(lookahead, frames + CUT_AT, CLIP_FRAMES - CUT_AT, -1, part + CUT_AT,
+                     part_status);
+    return ok && memcmp(whole, part, sizeof whole) == 0;
+}
+
+static int count_cuts(const int *status, int n)
+{
+    int t, cuts = 0;
+    for (t = 0; t < n; t++) cuts += status[t] == HOME_STAB_MOTION_CUT;
+    return cuts;
+}
+
+/* A hard cut to another scene under the same shake is found at its frame, and only there, and
+ * the path restarts there (causal and with a lookahead). */
+static void test_cut_restarts_path(void)
+{
+    static uint8_t other[CLIP_FRAMES][CW * CH * 3 / 2];
+    static int status[CLIP_FRAMES];
+    uint8_t *frames[CLIP_FRAMES];
+    static const int lookaheads[] = {0, 8};
+    int t, k;
+    render_clip();
+    for (t = 0; t < CLIP_FRAMES; t++) {
+        if (t >= CUT_AT) {
+            synth_render(SYNTH_STRUCTURED, 4, clip_g[t], 1.0, (uint64_t)t + 500, other[t], CW,
+                         CH, CW);
+            memset(other[t] + CW * CH, 128, CW * CH / 2);
+        }
+        frames[t] = t < CUT_AT ? clip[t] : other[t];
+    }
+    for (k = 0; k < 2; k++) {
+        const int same = cut_matches_parts(lookaheads[k], frames, -1, status);
+        printf("    lookahead %d: %d cut(s) found, at frame %d: %s; warps %s the parts'\n",
+               lookaheads[k], count_cuts(status, CLIP_FRAMES), CUT_AT,
+               status[CUT_AT] == HOME_STAB_MOTION_CUT ? "yes" : "no",
+               same ? "equal to" : "differ from");
+        CHECK_EQ_INT(status[CUT_AT], HOME_STAB_MOTION_CUT);
+        CHECK_EQ_INT(count_cuts(status, CLIP_FRAMES), 1);
+        CHECK(same);
+    }
+}
+
+/* home_stab_cut() restarts the path at the next frame, on a stream with no visible cut. */
+static void test_caller_cut(void)
+{
+    static int status[CLIP_FRAMES];
+    uint8_t *frames[CLIP_FRAMES];
+    int t;
+    render_clip();
+    for (t = 0; t < CLIP_FRAMES; t++) frames[t] = clip[t];
+    CHECK(cut_matches_parts(6, frames, CUT_AT, status));
+    CHECK_EQ_INT(status[CUT_AT], HOME_STAB_MOTION_CUT);
+    CHECK_EQ_INT(count_cuts(status, CLIP_FRAMES), 1);
+}
+
+/* Exposure steps of +-1 EV and a fade through black are not cuts: the path goes on. */
+static void test_no_cut_on_exposure_or_fade(void)
+{
+    static uint8_t lit[CLIP_FRAMES][CW * CH * 3 / 2];
+    static double warp[CLIP_FRAMES][9];
+    static int status[CLIP_FRAMES];
+    uint8_t *frames[CLIP_FRAMES];
+    int t, i, held = 0;
+    render_clip();
+    for (t = 0; t < CLIP_FRAMES; t++) {
+        /* x2 for frames 15..29, x0.5 for 30..44, a fade to black and back over 50..63 */
+        double gain = t >= 15 && t < 30 ? 2.0 : t >= 30 && t < 45 ? 0.5 : 1.0;
+        if (t >= 50 && t < 64) gain = fabs(t - 56.5) / 7.5;
+        for (i = 0; i < CW * CH; i++) {
+            const double v = gain * clip[t][i];
+            lit[t][i] = (uint8_t)(v > 255.0 ? 255 : v + 0.5);
+        }
+        memset(lit[t] + CW * CH, 128, CW * CH / 2);
+        frames[t] = lit[t];
+    }
+    CHECK(run_frames(8, frames, CLIP_FRAMES, -1, warp, status));
+    for (t = 1; t < CLIP_FRAMES; t++) held += status[t] != HOME_STAB_MOTION_OK;
+    printf("    %d cuts, %d frames held of %d\n", count_cuts(status, CLIP_FRAMES), held,
+           CLIP_FRAMES - 1);
+    CHECK_EQ_INT(count_cuts(status, CLIP_FRAMES), 0);
+}
+
 #define STAB_TESTS(X) \
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
     X(warp_formats_agree) X(warp_bands_match_whole) X(jitter_reduced_causal) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
-    X(deterministic) X(static_camera_moving_object)
+    X(deterministic) X(static_camera_moving_object) X(cut_restarts_path) X(caller_cut) \
+    X(no_cut_on_exposure_or_fade)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
 

@@ -77,7 +77,7 @@ static void check_output(const home_stab_output *out)
     if (!out->ready) return;
     for (k = 0; k < 9; k++) FZ_CHECK(isfinite(out->warp[k]));
     FZ_CHECK(out->correction_used >= 0.0 && out->correction_used <= 1.0);
-    FZ_CHECK(out->motion_status >= HOME_STAB_MOTION_FIRST && out->motion_status <= HOME_STAB_MOTION_IMPLAUSIBLE);
+    FZ_CHECK(out->motion_status >= HOME_STAB_MOTION_FIRST && out->motion_status <= HOME_STAB_MOTION_CUT);
     FZ_CHECK(isfinite(out->raw.tx) && isfinite(out->raw.ty) && isfinite(out->smooth.angle));
 }
 
@@ -107,7 +107,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         float f = fz_float_bits(r);
         int32_t raw = (int32_t)fz_u32(r);
         switch (fz_u8(r) % 11) {
-        case 0: cfg.margin = f; break;
+        case 0: if (raw & 1) cfg.margin_x = f; else cfg.margin_y = f; break;
         case 1: cfg.smoothing = f; break;
         case 2: cfg.lookahead = raw % 256; break;
         case 3: cfg.downscale = raw % 8; break;
@@ -154,6 +154,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (k = 0; k < (n ? n : 1); k++) valid[k] = make_frame(r, &frames[k], k, fmt, cfg.width, cfg.height, pad, scene, dx, dy);
 
     for (k = 0; k < n; k++) {
+        if (fz_u8(r) % 8 == 0) FZ_CHECK(home_stab_cut(stab) == HOME_OK);
         s = home_stab_push(stab, &frames[k], &out);
         FZ_CHECK(is_status(s));
         if (valid[k]) FZ_CHECK(s == HOME_OK);
