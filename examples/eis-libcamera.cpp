@@ -38,7 +38,7 @@ struct Options {
     std::string format = "yu12";
     long frames = 0;
     float margin = 0.10f, smoothing = 0.0f;   // 0: automatic (see home_stab_config)
-    int lookahead = 0;
+    int lookahead = EIS_LIVE_LOOKAHEAD;
     bool quiet = false;
 };
 

@@ -84,6 +84,7 @@ static int parse(int argc, char **argv, options *o)
     o->fourcc = V4L2_PIX_FMT_YUYV;
     o->buffers = 4; o->timeout_ms = 2000; o->window = 1;
     o->margin = 0.10f; o->smoothing = 0.0f;   /* automatic */
+    o->lookahead = EIS_LIVE_LOOKAHEAD;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         char *end = NULL;

@@ -9,6 +9,10 @@
 extern "C" {
 #endif
 
+/* The live examples' default lookahead: 6 frames (200 ms at 30 fps) of latency leave a fifth
+ * of the causal filter's jitter (docs/stabiliser.md, "Defaults per tool"). */
+#define EIS_LIVE_LOOKAHEAD 6
+
 /* Monotonic milliseconds (a home_clock_fn). */
 double eis_now_ms(void *user);
 /* Bytes of a tightly packed w x h frame of a HOME_STAB_* format (YUYV, NV12 or I420). */

@@ -11,7 +11,18 @@
  * fill the frame). The correction is shrunk towards identity whenever the window would leave the
  * frame, so the output never shows pixels from outside the input. A failed or implausible
  * registration is taken as "no motion": the path holds and the correction decays smoothly towards
- * identity.
+ * identity. A still camera stays still: a motion among frames that register as the identity (at
+ * least 2 of the 4 nearest, up to 2 of them ahead within the lookahead, and no other motion
+ * among them) is taken as none, unless it moves the corners by more than 2 % of the half
+ * diagonal (a knocked tripod).
+ *
+ * Scene cuts: a frame that cannot be registered to its predecessor and whose coarse luma (16x16
+ * cell means) correlates below 0.5 with the predecessor's at every shift up to max_shift, once
+ * gain and offset are allowed for, starts a new scene (or home_stab_cut() says so). The frames
+ * still due before it are smoothed as if the stream ended there, and the path restarts at it:
+ * no smoothing window spans the cut and no frame is warped by motion from the other side.
+ * Exposure steps and fades are not cuts (the correlation ignores gain and offset; a flat frame
+ * tells nothing).
  *
  * Frames, latency and memory: the caller owns every frame buffer. home_stab_push() takes the
  * newest frame (only its luma is read) and, once N = lookahead frames are queued behind it,
@@ -106,7 +117,9 @@ enum home_stab_motion_status {
     HOME_STAB_MOTION_OK,        /* HOME's H, fitted by a similarity, is the motion */
     HOME_STAB_MOTION_FAILED,    /* HOME found no trustworthy H: held (no motion) */
     HOME_STAB_MOTION_IMPLAUSIBLE, /* H outside the configured limits: held (no motion) */
-    HOME_STAB_MOTION_CUT        /* a scene cut (or home_stab_cut()): the path restarts here */
+    HOME_STAB_MOTION_CUT,       /* a scene cut (or home_stab_cut()): the path restarts here */
+    HOME_STAB_MOTION_STILL      /* a small motion among frames registered as the identity (a
+                                   still camera): taken as none */
 };
 
 /* A similarity about the image centre c: p -> exp(log_scale) R(angle) (p - c) + c + (tx, ty). */

@@ -16,6 +16,8 @@
 #define REGIONS_X 8          /* the identity test's grid of regions (refine_static.c) */
 #define REGIONS_Y 6
 #define REGION_TOP 8         /* the identity test's points per region: the strongest blocks */
+#define REGION_WEAK_SCORE 2  /* ... or, where none pass the level's floor, the blocks with a score
+                                |gx| + |gy| (2x central differences) of at least this */
 #define REGION_CAPACITY (REGIONS_X * REGIONS_Y * REGION_TOP)
 
 /* One refinement: the template, the estimate and the solver's state. */
@@ -56,6 +58,8 @@ static inline double robust_cost(double r, double c)
 
 /* refine_snapshot.c: points a match-time scratch buffer holds */
 int home__refine_match_capacity(const home_config *cfg);
+/* The score |gx| + |gy| a region point of `level` needs to count as textured. */
+int home__refine_region_floor(int level);
 
 /* refine_solve.c */
 void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver *s);

@@ -266,16 +266,22 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
 }
 
 /* The identity test's points from the block cells select_points left for this level: of every
- * region, its REGION_TOP strongest blocks above the level's floor (ties: scan order). A moving
- * object's texture fills the template's capacity, and the static background then has no say;
- * per region it keeps its own. */
+ * region, its REGION_TOP strongest blocks above the level's floor (ties: scan order), or, in a
+ * region with none, above REGION_WEAK_SCORE (a horizon in fog). A moving object's texture fills
+ * the template's capacity, and the static background then has no say; per region it keeps its
+ * own. */
+int home__refine_region_floor(int level)
+{
+    return (score_floor(level) / 2 + 1) * 2;
+}
+
 static void select_region_points(const uint8_t *img, int w, int h, int level,
                                  const uint16_t *cells, home__refine_points *out)
 {
     const int b = block_side(level);
     const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
     const int log2b = b == 4 ? 2 : b == 2 ? 1 : 0;
-    const int floor_key = (score_floor(level) / 2 + 1) << 5;
+    const int floor_key = home__refine_region_floor(level) << 4, weak_key = REGION_WEAK_SCORE << 4;
     int16_t key[REGION_CAPACITY];
     int bx, by, i, j, r, n = 0;
     for (i = 0; i < REGION_CAPACITY; i++) key[i] = 0;
@@ -283,7 +289,7 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
         for (bx = 0; bx < bw; bx++) {
             const int k = cells[by * bw + bx];
             int x, y;
-            if (k < floor_key) continue;
+            if (k < weak_key) continue;
             x = bx * b + (k & (b - 1));
             y = by * b + ((k & 15) >> log2b);
             r = region_of(x, y, w, h) * REGION_TOP;
@@ -300,7 +306,8 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
         }
     }
     for (i = 0; i < REGION_CAPACITY; i++) {
-        if (!key[i]) continue;
+        /* a region with blocks above the floor keeps only those */
+        if (!key[i] || (key[i] < floor_key && key[i - i % REGION_TOP] >= floor_key)) continue;
         out->x[n] = out->x[i];
         out->y[n] = out->y[i];
         out->t[n] = (int16_t)img[(ptrdiff_t)out->y[n] * w + out->x[n]];

@@ -21,6 +21,9 @@ void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t s
 #define HOME__STAB_THUMB_SIDE 16
 #define HOME__STAB_THUMB_CELLS (HOME__STAB_THUMB_SIDE * HOME__STAB_THUMB_SIDE)
 
+/* Slots of path history at least (stab_still.c looks at 4 frames before a motion). */
+#define HOME__STAB_MIN_RING 5
+
 /* One frame of path history. Path components are normalised to pixels (angle and log scale
  * times the half diagonal) so that one filter covariance serves all four of them. */
 typedef struct stab_slot {
@@ -30,6 +33,8 @@ typedef struct stab_slot {
     home_stab_sim raw;            /* camera path: frame 0 -> this frame */
     double xf[4][2], xp[4][2];    /* filtered / predicted (position, velocity) per component */
     double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
+    home_stab_sim motion;         /* the motion from the previous frame taken (0 when held) */
+    int registered_still;         /* the registration was the identity */
     int smoothed_ready;           /* its segment has ended: `smoothed` is its final path */
     home_stab_sim smoothed;
 } stab_slot;
@@ -44,7 +49,8 @@ struct home_stab {
     /* HOME's box downscale of planar rows (its backend's): the same rounding as the reference
      * loop in registration_luma() */
     void (*box_down)(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t *out, int out_w);
-    stab_slot *ring;              /* 2 lookahead + 1 slots, frame n in ring[n % len] */
+    stab_slot *ring;              /* 2 lookahead + 1 slots (at least HOME__STAB_MIN_RING), frame n
+                                     in ring[n % len] */
     int ring_len;
     long pushed, emitted;
     long first;                   /* first frame of the current segment (a cut starts one) */
@@ -75,6 +81,10 @@ void home__stab_kalman_step(const home_stab *st, const stab_slot *prev, stab_slo
 void home__stab_refilter_mirrored_start(const home_stab *st, long first, long last);
 void home__stab_end_segment(home_stab *st, long last);
 home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last);
+
+/* stab_still.c */
+long home__stab_still_delay(const home_stab *st);
+void home__stab_settle_still(home_stab *st, long t, long newest);
 
 /* stab_cut.c */
 void home__stab_thumbnail(const uint8_t *luma, ptrdiff_t stride, int w, int h, float *thumb);

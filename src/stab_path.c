@@ -120,6 +120,7 @@ static void append_mirrored_end(home_stab *st, long first, long last)
         cur->frame = last + i;
         cur->status = HOME_STAB_MOTION_OK;
         cur->weight = 1.0;
+        cur->registered_still = 0;
         cur->smoothed_ready = 0;
         home__stab_kalman_step(st, slot_of(st, last + i - 1), cur, z);
     }

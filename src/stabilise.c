@@ -129,6 +129,11 @@ int home_stab_validate_config(const home_stab_config *cfg)
     return home_config_for(cfg, &h);
 }
 
+static int ring_length(const home_stab_config *cfg)
+{
+    return 2 * cfg->lookahead + 1 < HOME__STAB_MIN_RING ? HOME__STAB_MIN_RING : 2 * cfg->lookahead + 1;
+}
+
 typedef struct stab_layout {
     size_t stab, home, feat, small, ring, total;
     size_t home_bytes;
@@ -142,7 +147,7 @@ static void plan(const home_stab_config *cfg, const home_config *h, stab_layout 
     l->home = at; at = align_up(at + l->home_bytes);
     l->feat = at; at = align_up(at + 2 * sizeof(home_features));
     l->small = at; at = align_up(at + (size_t)h->width * (size_t)h->height);
-    l->ring = at; at = align_up(at + (size_t)(2 * cfg->lookahead + 1) * sizeof(stab_slot));
+    l->ring = at; at = align_up(at + (size_t)ring_length(cfg) * sizeof(stab_slot));
     l->total = at;
 }
 
@@ -190,7 +195,7 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     st->small_w = h.width;
     st->small_h = h.height;
     st->ring = (stab_slot *)(void *)(base + l.ring);
-    st->ring_len = 2 * cfg->lookahead + 1;
+    st->ring_len = ring_length(cfg);
     /* Kalman bandwidth ~ (q/r)^(1/4) per frame for the constant-velocity model */
     st->r = 1.0;
     st->q = 1.0 / pow(stab_time_constant(cfg), 4.0);
@@ -215,6 +220,16 @@ int home_stab_cut(home_stab *st)
     if (st->magic != STAB_MAGIC) return HOME_E_STATE;
     st->cut_requested = 1;
     return HOME_OK;
+}
+
+/* The segment ends with frame last: its motions still undecided are settled with the frames
+ * there are after them, and every frame still due is smoothed over the mirrored end. */
+static void end_segment(home_stab *st, long last)
+{
+    long t;
+    for (t = last - home__stab_still_delay(st) + 1; t <= last; t++)
+        home__stab_settle_still(st, t, last);
+    home__stab_end_segment(st, last);
 }
 
 /* A frame HOME could not register to its predecessor starts a new scene when its coarse luma is
@@ -332,7 +347,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     ptrdiff_t stride;
     home_features *swap;
     home_stab_sim motion = {0, 0, 0, 0};
-    double weight = 1.0;
+    double weight = 1.0, sigma = 0.0;
     stab_slot *slot;
     double t0 = 0, z[4];
     long n;
@@ -360,10 +375,10 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
             if (res >= 0.0 && res <= st->cfg.max_residual &&
                 hypot(s.tx, s.ty) <= st->cfg.max_shift * st->cfg.width &&
                 fabs(s.angle) <= st->cfg.max_rotation && fabs(s.log_scale) <= st->cfg.max_zoom) {
-                const double sigma = out->reg.sigma_px * st->cfg.downscale / STAB_SIGMA_REF_PX;
+                sigma = out->reg.sigma_px * st->cfg.downscale;
                 out->newest_status = HOME_STAB_MOTION_OK;
                 motion = s;
-                weight = 1.0 + sigma * sigma;
+                weight = 1.0 + (sigma / STAB_SIGMA_REF_PX) * (sigma / STAB_SIGMA_REF_PX);
             }
         }
     }
@@ -376,10 +391,11 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
                   (out->newest_status != HOME_STAB_MOTION_OK && is_scene_cut(st)))) {
         /* a new scene: the frames still due are smoothed as if the stream ended before it, and
          * its path starts afresh, so no smoothing window and no motion spans the cut */
-        if (st->emitted < n) home__stab_end_segment(st, n - 1);
+        if (st->emitted < n) end_segment(st, n - 1);
         st->first = n;
         out->newest_status = HOME_STAB_MOTION_CUT;
         weight = 1.0;   /* as a stream's first frame */
+        memset(&motion, 0, sizeof motion);
     }
     st->cut_requested = 0;
     if (st->cfg.clock) out->ms_register = st->cfg.clock(st->cfg.clock_user) - t0;
@@ -388,6 +404,9 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     slot->frame = n;
     slot->status = out->newest_status;
     slot->weight = weight;
+    slot->motion = motion;
+    slot->registered_still = out->newest_status == HOME_STAB_MOTION_OK &&
+                             out->reg.model == HOME_MODEL_IDENTITY;
     slot->smoothed_ready = 0;
     if (n == st->first) {
         memset(&slot->raw, 0, sizeof slot->raw);
@@ -401,6 +420,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     }
     st->pushed = n + 1;
     st->tail = 0;
+    home__stab_settle_still(st, n - home__stab_still_delay(st), n);
     if (n - st->first == st->cfg.lookahead) home__stab_refilter_mirrored_start(st, st->first, n);
     if (n - st->emitted >= st->cfg.lookahead) emit(st, n, out);
     return HOME_OK;
@@ -413,7 +433,7 @@ int home_stab_flush(home_stab *st, home_stab_output *out)
     memset(out, 0, sizeof *out);
     if (st->emitted >= st->pushed) return HOME_OK;
     if (!st->tail) {
-        home__stab_end_segment(st, st->pushed - 1);
+        end_segment(st, st->pushed - 1);
         st->tail = 1;
     }
     emit(st, st->emitted + st->cfg.lookahead, out);

@@ -392,7 +392,10 @@ def static_clips(which):
                 (Item("white table, a cube and a cylinder (static, plain, indoor), objects "
                       "moving in front", photo=_tp("image0000")), tex),
                 (Item("ornate building in fog (static, hazy), objects moving in front",
-                      photo=_tp("home"), condition="fog"), tex)]
+                      photo=_tp("home"), condition="fog"), tex),
+                # added in session 10 (issue 18: a tripod shot of a horizon in fog)
+                (Item("ridge line in fog (static, textureless), objects moving in front",
+                      scene=("fog_horizon", "A", "static0")), tex)]
     if which == "sealed":
         S = SEALED
         tex = [S["jaguars"], S["hedgehog"], S["komodo"], S["sheep"]]
