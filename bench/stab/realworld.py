@@ -748,7 +748,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--set", default="all", choices=["tuning", "test", "all"])
-    ap.add_argument("--quick", action="store_true", help="three short clips (under 3 min)")
+    ap.add_argument("--quick", action="store_true", help="four short clips (under 3 min)")
     ap.add_argument("--clips", default="", help="comma-separated clip names (see the report)")
     ap.add_argument("--build", default="build")
     ap.add_argument("--out", default=None,
