@@ -68,3 +68,14 @@ eval-trust: $(BUILD)/bin/home-register $(BUILD)/bin/home-stab eval-deps
 
 eval-trust-quick: $(BUILD)/bin/home-register $(BUILD)/bin/home-stab eval-deps
 	$(EVAL_TRUST) --quick
+
+# make bench-stab-realworld: home-stab against vidstab and deshake on the real-world set
+# (bench/stab/realworld.py: rendered clips with cuts, fades, occluders, exposure steps, codecs,
+# zoom and pans, and ViSP's real sequences; per-clip table in
+# $(BUILD)/bench-stab-realworld/results.md). Needs ffmpeg with vid.stab; about 45 min on 2 cores.
+# BENCH_STAB_ARGS: more realworld.py options, e.g. --set tuning, --quick, --clips cuts_test,
+#   --stab-args "--lookahead 10"
+BENCH_STAB_ARGS ?=
+.PHONY: bench-stab-realworld
+bench-stab-realworld: $(BUILD)/bin/home-stab $(BUILD)/bin/home-stab-clip eval-deps
+	$(EVAL_PYTHON) bench/stab/realworld.py --build $(BUILD) --cache $(EVAL_CACHE) $(BENCH_STAB_ARGS)

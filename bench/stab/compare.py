@@ -304,6 +304,21 @@ def set_size(text):
     ALIGN_LEVELS = 1 + int(round(np.log2(W / 160.0)))
 
 
+def method_commands(stab, extra):
+    """Method name -> f(input, output) giving the commands to run, in order (extra: more
+    home-stab options)."""
+    return {
+        "home-stab": lambda c, o: [[str(stab), "--quiet"] + extra + [c, o]],
+        "home-stab la15": lambda c, o: [[str(stab), "--quiet", "--lookahead", "15"] + extra + [c, o]],
+        "vidstab": lambda c, o: [
+            ["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "vidstabdetect=result=%s.trf" % o, "-f", "null", "-"],
+            ["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "vidstabtransform=input=%s.trf:crop=black:optzoom=1:smoothing=15" % o,
+             "-pix_fmt", "yuv420p", "-f", "yuv4mpegpipe", o]],
+        "deshake": lambda c, o: [["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "deshake=edge=blank", "-pix_fmt", "yuv420p",
+                                  "-f", "yuv4mpegpipe", o]],
+    }
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build")
@@ -329,17 +344,7 @@ def main():
         if not tool.exists():
             sys.exit("%s missing: run make BUILD=%s first" % (tool, args.build))
 
-    extra = args.stab_args.split()
-    methods = {
-        "home-stab": lambda c, o: [[str(stab), "--quiet"] + extra + [c, o]],
-        "home-stab la15": lambda c, o: [[str(stab), "--quiet", "--lookahead", "15"] + extra + [c, o]],
-        "vidstab": lambda c, o: [
-            ["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "vidstabdetect=result=%s.trf" % o, "-f", "null", "-"],
-            ["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "vidstabtransform=input=%s.trf:crop=black:optzoom=1:smoothing=15" % o,
-             "-pix_fmt", "yuv420p", "-f", "yuv4mpegpipe", o]],
-        "deshake": lambda c, o: [["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "deshake=edge=blank", "-pix_fmt", "yuv420p",
-                                  "-f", "yuv4mpegpipe", o]],
-    }
+    methods = method_commands(stab, args.stab_args.split())
     chosen = [m.strip() for m in args.methods.split(",")]
     for m in chosen:
         if m not in methods:
