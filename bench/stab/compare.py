@@ -308,7 +308,8 @@ def method_commands(stab, extra):
     """Method name -> f(input, output) giving the commands to run, in order (extra: more
     home-stab options)."""
     return {
-        "home-stab": lambda c, o: [[str(stab), "--quiet"] + extra + [c, o]],
+        # causal: home-stab's own default lookahead is 30 frames (a file has no latency limit)
+        "home-stab": lambda c, o: [[str(stab), "--quiet", "--lookahead", "0"] + extra + [c, o]],
         "home-stab la15": lambda c, o: [[str(stab), "--quiet", "--lookahead", "15"] + extra + [c, o]],
         "vidstab": lambda c, o: [
             ["ffmpeg", "-v", "error", "-y", "-i", c, "-vf", "vidstabdetect=result=%s.trf" % o, "-f", "null", "-"],
