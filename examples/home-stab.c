@@ -48,6 +48,10 @@ static void usage(FILE *f)
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
             "                    its 1/2 or 1/4 size copy (2, 4; default: the one about 160 px wide)\n"
             "  --theta-bins N    HOME's theta bins (16..%d; default 88)\n"
+            "  --fixed-crop      crop by the whole margins; the default for a file IN is two\n"
+            "                    passes over it with the smallest share of the margins that every\n"
+            "                    frame's whole correction needs (less zoom where the shake is\n"
+            "                    small, never a border; a pipe always gets the whole margins)\n"
             "  --side-by-side    write original | stabilised, twice as wide\n"
             "  --csv FILE        per frame: raw and smoothed camera path (tx, ty px, angle rad,\n"
             "                    log scale), share of the correction applied, and the warp\n"
@@ -79,6 +83,35 @@ typedef struct reg_info {
     int inliers, model;           /* model: enum home_model */
     double sigma_px;              /* predicted RMS corner error, registration px (inf: none) */
 } reg_info;
+
+/* The adaptive crop (a file's default): what the first pass keeps of every frame's output. */
+typedef struct planned {
+    home_stab_sim raw, smooth;
+    int status;
+    reg_info reg;
+} planned;
+
+typedef struct plan {
+    planned *frames;
+    long n, capacity;
+} plan;
+
+static int plan_add(plan *p, const home_stab_output *o, const reg_info *reg)
+{
+    if (p->n == p->capacity) {
+        long cap = p->capacity ? 2 * p->capacity : 256;
+        planned *grown = realloc(p->frames, (size_t)cap * sizeof *grown);
+        if (!grown) { fprintf(stderr, "home-stab: out of memory\n"); return -1; }
+        p->frames = grown;
+        p->capacity = cap;
+    }
+    p->frames[p->n].raw = o->raw;
+    p->frames[p->n].smooth = o->smooth;
+    p->frames[p->n].status = o->motion_status;
+    p->frames[p->n].reg = *reg;
+    p->n++;
+    return 0;
+}
 
 typedef struct app {
     y4m_info info;
@@ -217,6 +250,50 @@ static int finish_writer(app *ap)
     return ap->failed ? -1 : 0;
 }
 
+/* The adaptive crop's second pass: the margins scaled to the largest share any frame's whole
+ * correction needs, then every planned frame read again from `in` (at data_start) and written
+ * through them. The registrations are not repeated: the warp follows from the planned path. */
+static int write_planned(app *ap, const plan *p, home_stab_config cfg, FILE *in, long data_start,
+                         const char *in_path)
+{
+    double share = 0.0;
+    char err[256];
+    long i;
+    for (i = 0; i < p->n; i++) {
+        double s;
+        if (home_stab_margin_share(&cfg, &p->frames[i].raw, &p->frames[i].smooth, &s) != HOME_OK)
+            s = 1.0;
+        if (s > share) share = s;
+    }
+    cfg.margin_x = (float)(share * cfg.margin_x);
+    cfg.margin_y = (float)(share * cfg.margin_y);
+    if (!ap->quiet)
+        fprintf(stderr, "home-stab: adaptive crop: margins %.4f x %.4f (%.0f %% of the maximum)\n",
+                cfg.margin_x, cfg.margin_y, 100.0 * share);
+    if (fseek(in, data_start, SEEK_SET)) {
+        fprintf(stderr, "home-stab: %s: cannot read it again for the adaptive crop\n", in_path);
+        return -1;
+    }
+    for (i = 0; i < p->n; i++) {
+        home_stab_output o;
+        uint8_t *buf = ap->ring[i % ap->ring_len];
+        if (y4m_read_frame(in, &ap->info, buf, err, sizeof err) <= 0) {
+            fprintf(stderr, "home-stab: %s: frame %ld changed between the passes\n", in_path, i);
+            return -1;
+        }
+        memset(&o, 0, sizeof o);
+        o.ready = 1;
+        o.frame = i;
+        o.raw = p->frames[i].raw;
+        o.smooth = p->frames[i].smooth;
+        o.motion_status = p->frames[i].status;
+        home_stab_crop_warp(&cfg, &o.raw, &o.smooth, o.warp, &o.correction_used);
+        ap->reg[i % ap->ring_len] = p->frames[i].reg;
+        if (emit_output(ap, &o)) return -1;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *in_path = NULL, *out_path = NULL, *csv_path = NULL, *plot_path = NULL;
@@ -231,7 +308,9 @@ int main(int argc, char **argv)
     void *arena = NULL;
     FILE *in;
     char err[256];
-    int i, status, rc = 0, got, refine = 1;
+    int i, status, rc = 0, got, refine = 1, adaptive = 1;
+    plan planned_path = {NULL, 0, 0};
+    long data_start = 0;
     long frames = 0, failed = 0, cuts = 0;
     size_t need;
 
@@ -243,6 +322,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--side-by-side")) { ap.side_by_side = 1; continue; }
         if (!strcmp(a, "--quiet")) { ap.quiet = 1; continue; }
         if (!strcmp(a, "--no-refine")) { refine = 0; continue; }
+        if (!strcmp(a, "--fixed-crop")) { adaptive = 0; continue; }
         if (!strcmp(a, "-") || a[0] != '-') {
             if (!in_path) in_path = a;
             else if (!out_path) out_path = a;
@@ -277,6 +357,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "home-stab: %s: %s\n", in_path, err);
         return 2;
     }
+    /* the adaptive crop reads the input twice: a pipe gets the whole margins */
+    if (adaptive && (in == stdin || (data_start = ftell(in)) < 0 || fseek(in, data_start, SEEK_SET)))
+        adaptive = 0;
     status = home_stab_default_config(&cfg, ap.info.width, ap.info.height);
     cfg.margin_x = (float)(margin_x >= 0 ? margin_x : margin);
     cfg.margin_y = (float)(margin_y >= 0 ? margin_y : margin);
@@ -352,7 +435,8 @@ int main(int argc, char **argv)
         cuts += o.newest_status == HOME_STAB_MOTION_CUT;
         ms_reg += o.ms_register;
         frames++;
-        if (o.ready && emit_output(&ap, &o)) { rc = 2; break; }
+        if (o.ready && (adaptive ? plan_add(&planned_path, &o, &ap.reg[o.frame % ap.ring_len])
+                                 : emit_output(&ap, &o))) { rc = 2; break; }
         if (!ap.quiet && now_ms(NULL) - last_report >= 1000.0) {
             double ms_warp, written;
             if (ap.threaded) pthread_mutex_lock(&ap.lock);
@@ -366,7 +450,11 @@ int main(int argc, char **argv)
         }
     }
     while (rc != 2 && home_stab_flush(stab, &o) == HOME_OK && o.ready)
-        if (emit_output(&ap, &o)) { rc = 2; break; }
+        if (adaptive ? plan_add(&planned_path, &o, &ap.reg[o.frame % ap.ring_len])
+                     : emit_output(&ap, &o)) { rc = 2; break; }
+    if (adaptive && rc != 2 && write_planned(&ap, &planned_path, cfg, in, data_start, in_path))
+        rc = 2;
+    free(planned_path.frames);
     if (finish_writer(&ap)) rc = 2;
     if (fflush(ap.out) != 0) { fprintf(stderr, "home-stab: write error\n"); rc = 2; }
     if (!ap.quiet)

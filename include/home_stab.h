@@ -190,6 +190,20 @@ int home_stab_warp(const double *warp, const home_stab_image *src, home_stab_ima
 int home_stab_warp_rows(const double *warp, const home_stab_image *src, home_stab_image *dst,
                         int first_row, int rows);
 
+/* The warp home_stab_push() reports for a frame of camera path raw and smoothed path smooth,
+ * through cfg's crop margins (the correction shrunk where the window would leave the frame;
+ * *correction_used, if not NULL, gets the share kept): for a caller that picks the margins
+ * after seeing the whole path (home-stab's adaptive crop). HOME_E_CONFIG for a path that is not
+ * finite. */
+int home_stab_crop_warp(const home_stab_config *cfg, const home_stab_sim *raw,
+                        const home_stab_sim *smooth, double *warp, double *correction_used);
+
+/* The smallest share (0..1) of cfg's margins, both scaled by it (margin_x = (float)(share *
+ * margin_x), the same for y), through which the frame's whole correction keeps the window inside
+ * the frame; 1 when it needs them all or more. */
+int home_stab_margin_share(const home_stab_config *cfg, const home_stab_sim *raw,
+                           const home_stab_sim *smooth, double *share);
+
 /* Similarity parameters <-> 3x3 matrices (about the centre of a width x height frame). */
 void home_stab_sim_to_matrix(const home_stab_sim *s, int width, int height, double *m);
 

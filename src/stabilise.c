@@ -275,15 +275,17 @@ static const uint8_t *registration_luma(home_stab *st, const home_stab_image *im
     return st->small;
 }
 
-/* output pixel -> input pixel for a correction (virtual camera -> real camera) share k */
-static void crop_warp(const home_stab *st, const home_stab_sim *corr, double k, double *m)
+/* output pixel -> input pixel for a correction (virtual camera -> real camera) share k, through
+ * a window with margins mx, my */
+static void crop_warp(const home_stab_config *cfg, double mx, double my, const home_stab_sim *corr,
+                      double k, double *m)
 {
-    const double zx = 1.0 - 2.0 * st->cfg.margin_x, zy = 1.0 - 2.0 * st->cfg.margin_y;
-    const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
+    const double zx = 1.0 - 2.0 * mx, zy = 1.0 - 2.0 * my;
+    const double cx = 0.5 * (cfg->width - 1), cy = 0.5 * (cfg->height - 1);
     home_stab_sim part = home__stab_sim_scaled(corr, k);
     double d[9];
     int i;
-    home_stab_sim_to_matrix(&part, st->cfg.width, st->cfg.height, d);
+    home_stab_sim_to_matrix(&part, cfg->width, cfg->height, d);
     /* d after the zoom q -> c + diag(zx, zy) (q - c) */
     for (i = 0; i < 2; i++) {
         m[3 * i + 2] = d[3 * i + 0] * cx * (1 - zx) + d[3 * i + 1] * cy * (1 - zy) + d[3 * i + 2];
@@ -293,9 +295,9 @@ static void crop_warp(const home_stab *st, const home_stab_sim *corr, double k, 
     m[6] = 0; m[7] = 0; m[8] = 1;
 }
 
-static int window_inside(const home_stab *st, const double *m)
+static int window_inside(const home_stab_config *cfg, const double *m)
 {
-    const double xmax = st->cfg.width - 1, ymax = st->cfg.height - 1;
+    const double xmax = cfg->width - 1, ymax = cfg->height - 1;
     int i;
     for (i = 0; i < 4; i++) {
         double x = (i & 1) ? xmax : 0.0, y = (i & 2) ? ymax : 0.0, u, v;
@@ -305,33 +307,79 @@ static int window_inside(const home_stab *st, const double *m)
     return 1;
 }
 
+/* The warp for a frame of camera path raw and smoothed path smooth through margins mx, my: the
+ * whole correction, or the largest share of it that keeps the window inside (0 always does). */
+static double crop(const home_stab_config *cfg, double mx, double my, const home_stab_sim *raw,
+                   const home_stab_sim *smooth, double *warp)
+{
+    /* the real camera seen from the virtual (smoothed) one: raw after smooth^-1 */
+    const home_stab_sim inv_smooth = home__stab_sim_inverse(smooth);
+    const home_stab_sim corr = home__stab_sim_compose(raw, &inv_smooth);
+    double lo = 0.0, hi = 1.0;
+    int i;
+    crop_warp(cfg, mx, my, &corr, 1.0, warp);
+    if (window_inside(cfg, warp)) return 1.0;
+    for (i = 0; i < STAB_BISECT_STEPS; i++) {
+        double mid = 0.5 * (lo + hi), w[9];
+        crop_warp(cfg, mx, my, &corr, mid, w);
+        if (window_inside(cfg, w)) lo = mid; else hi = mid;
+    }
+    crop_warp(cfg, mx, my, &corr, lo, warp);
+    return lo;
+}
+
+static int valid_path(const home_stab_sim *s)
+{
+    return isfinite(s->tx) && isfinite(s->ty) && isfinite(s->angle) && isfinite(s->log_scale);
+}
+
+int home_stab_crop_warp(const home_stab_config *cfg, const home_stab_sim *raw,
+                        const home_stab_sim *smooth, double *warp, double *correction_used)
+{
+    double used;
+    int status;
+    if (!cfg || !raw || !smooth || !warp) return HOME_E_NULL;
+    if ((status = home_stab_validate_config(cfg)) != HOME_OK) return status;
+    if (!valid_path(raw) || !valid_path(smooth)) return HOME_E_CONFIG;
+    used = crop(cfg, cfg->margin_x, cfg->margin_y, raw, smooth, warp);
+    if (correction_used) *correction_used = used;
+    return HOME_OK;
+}
+
+int home_stab_margin_share(const home_stab_config *cfg, const home_stab_sim *raw,
+                           const home_stab_sim *smooth, double *share)
+{
+    double lo = 0.0, hi = 1.0, w[9];
+    int i, status;
+    if (!cfg || !raw || !smooth || !share) return HOME_E_NULL;
+    if ((status = home_stab_validate_config(cfg)) != HOME_OK) return status;
+    if (!valid_path(raw) || !valid_path(smooth)) return HOME_E_CONFIG;
+    *share = 1.0;
+    if (crop(cfg, cfg->margin_x, cfg->margin_y, raw, smooth, w) < 1.0) return HOME_OK;
+    /* the margins as the float fields a caller sets from the share */
+    for (i = 0; i < STAB_BISECT_STEPS; i++) {
+        const double mid = 0.5 * (lo + hi);
+        if (crop(cfg, (float)(mid * cfg->margin_x), (float)(mid * cfg->margin_y), raw, smooth, w) <
+            1.0)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    *share = hi;
+    return HOME_OK;
+}
+
 static void emit(home_stab *st, long last, home_stab_output *out)
 {
     const long m = st->emitted;
     const stab_slot *slot = slot_of(st, m);
-    home_stab_sim inv_smooth, corr;
-    double lo = 0.0, hi = 1.0;
-    int i;
     out->ready = 1;
     out->frame = m;
     out->raw = slot->raw;
     out->motion_status = slot->status;
     out->smooth = slot->smoothed_ready ? slot->smoothed : home__stab_smoothed_path(st, m, last);
-    /* the real camera seen from the virtual (smoothed) one: raw after smooth^-1 */
-    inv_smooth = home__stab_sim_inverse(&out->smooth);
-    corr = home__stab_sim_compose(&slot->raw, &inv_smooth);
-    crop_warp(st, &corr, 1.0, out->warp);
-    if (!window_inside(st, out->warp)) {
-        /* the largest share of the correction that keeps the window inside (0 always does) */
-        for (i = 0; i < STAB_BISECT_STEPS; i++) {
-            double mid = 0.5 * (lo + hi), w[9];
-            crop_warp(st, &corr, mid, w);
-            if (window_inside(st, w)) lo = mid; else hi = mid;
-        }
-        hi = lo;
-        crop_warp(st, &corr, lo, out->warp);
-    }
-    out->correction_used = hi;
+    out->correction_used =
+        crop(&st->cfg, st->cfg.margin_x, st->cfg.margin_y, &out->raw, &out->smooth, out->warp);
     st->emitted++;
 }
 

@@ -30,6 +30,7 @@ static union { unsigned char bytes[4u << 20]; double align; } arena, arena_other
 static union { unsigned char bytes[256]; double align; } junk;
 static size_t needed;
 static home_stab_config scfg, sbad;
+static home_stab_sim ssim;
 static home_stab *stab;
 static home_stab_image sframe, sdst;
 static home_stab_output sout;
@@ -62,6 +63,7 @@ static void fixture(void)
     memcpy(warp_m, h_init, sizeof warp_m);
     home_stab_default_config(&scfg, W, H);
     sbad = scfg;
+    memset(&ssim, 0, sizeof ssim);
     stab = NULL;
     if (home_stab_init(&stab, &scfg, ALIGNED_ARENA(stab_arena.bytes), ALIGNED_BYTES(stab_arena.bytes), NULL) != HOME_OK) ctx = NULL;
     memset(&sframe, 0, sizeof sframe);
@@ -266,6 +268,10 @@ static int y4m(const char *text, size_t size, int frames)
     X(stab_push_uninitialised, HOME_E_STATE, home_stab_push((home_stab *)(void *)junk.bytes, &sframe, &sout)) \
     X(stab_flush_null_output, HOME_E_NULL, home_stab_flush(stab, NULL)) \
     X(stab_cut_null, HOME_E_NULL, home_stab_cut(NULL)) \
+    X(stab_crop_warp_null_path, HOME_E_NULL, home_stab_crop_warp(&scfg, NULL, &ssim, warp_m, NULL)) \
+    X(stab_crop_warp_nan_path, HOME_E_CONFIG, (ssim.tx = NAN, home_stab_crop_warp(&scfg, &ssim, &ssim, warp_m, NULL))) \
+    X(stab_crop_warp_bad_config, HOME_E_CONFIG, (sbad.margin_x = 0.5f, home_stab_crop_warp(&sbad, &ssim, &ssim, warp_m, NULL))) \
+    X(stab_margin_share_null_out, HOME_E_NULL, home_stab_margin_share(&scfg, &ssim, &ssim, NULL)) \
     X(stab_cut_uninitialised, HOME_E_STATE, home_stab_cut((home_stab *)(void *)junk.bytes)) \
     X(stab_warp_projective, HOME_E_CONFIG, (warp_m[6] = 1e-3, home_stab_warp(warp_m, &sframe, &sdst))) \
     X(stab_warp_nan, HOME_E_CONFIG, (warp_m[2] = NAN, home_stab_warp(warp_m, &sframe, &sdst))) \

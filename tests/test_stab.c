@@ -665,6 +665,60 @@ static void test_static_camera_moving_object(void)
     CHECK_LT(worst, 0.05);
 }
 
+/* ---- the crop after the fact (home-stab's adaptive crop) ---- */
+
+/* home_stab_crop_warp() gives push's own warp from its paths, byte for byte; through the share
+ * of the margins home_stab_margin_share() reports the whole correction fits, and through a
+ * smaller one it does not. */
+static void test_crop_after_the_fact(void)
+{
+    home_stab_config cfg;
+    home_stab *st = make_stab(6, 1, 0);
+    home_stab_output o;
+    home_stab_image im;
+    int t, same = 1, fits = 1, tight = 1, n = 0;
+    double smallest = 1.0;
+    CHECK(st != NULL);
+    if (!st) return;
+    home_stab_default_config(&cfg, CW, CH);
+    render_clip();
+    for (t = 0; t < CLIP_FRAMES + 6; t++) {
+        double w[9], used, share;
+        if (t < CLIP_FRAMES) {
+            grey_image(clip[t], &im);
+            CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_OK);
+        } else {
+            CHECK_EQ_INT(home_stab_flush(st, &o), HOME_OK);
+        }
+        if (!o.ready) continue;
+        n++;
+        CHECK_EQ_INT(home_stab_crop_warp(&cfg, &o.raw, &o.smooth, w, &used), HOME_OK);
+        same &= memcmp(w, o.warp, sizeof w) == 0 && used == o.correction_used;
+        CHECK_EQ_INT(home_stab_margin_share(&cfg, &o.raw, &o.smooth, &share), HOME_OK);
+        if (share < smallest) smallest = share;
+        if (share < 1.0) {
+            home_stab_config c = cfg;
+            c.margin_x = (float)(share * cfg.margin_x);
+            c.margin_y = (float)(share * cfg.margin_y);
+            home_stab_crop_warp(&c, &o.raw, &o.smooth, w, &used);
+            fits &= used == 1.0;
+            c.margin_x = (float)((share - 0.02) * cfg.margin_x);
+            c.margin_y = (float)((share - 0.02) * cfg.margin_y);
+            if (share > 0.02) {
+                home_stab_crop_warp(&c, &o.raw, &o.smooth, w, &used);
+                tight &= used < 1.0;
+            }
+        }
+    }
+    printf("    %d frames: warps %s push's, smallest share of the margins needed %.3f\n", n,
+           same ? "equal to" : "differ from", smallest);
+    CHECK_EQ_INT(n, CLIP_FRAMES);
+    CHECK(same);
+    CHECK(fits);
+    CHECK(tight);
+    CHECK_LT(smallest, 1.0);
+}
+
 /* ---- scene cuts ---- */
 
 /* Stabilise frames[0..n) (I420 buffers) with the given lookahead, calling home_stab_cut() before
@@ -791,7 +845,7 @@ static void test_no_cut_on_exposure_or_fade(void)
     X(warp_formats_agree) X(warp_bands_match_whole) X(jitter_reduced_causal) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
     X(deterministic) X(static_camera_moving_object) X(cut_restarts_path) X(caller_cut) \
-    X(no_cut_on_exposure_or_fade)
+    X(no_cut_on_exposure_or_fade) X(crop_after_the_fact)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
 

@@ -163,7 +163,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         pushed++;
         check_output(&out);
         if (out.ready) {
+            double again[9];
             FZ_CHECK(out.frame > last && out.frame < k + 1);
+            /* the warp follows from the paths alone (home-stab's adaptive crop relies on it) */
+            FZ_CHECK(home_stab_crop_warp(&cfg, &out.raw, &out.smooth, again, NULL) == HOME_OK &&
+                     memcmp(again, out.warp, sizeof again) == 0);
             last = out.frame;
             /* the stabiliser's own warp is one the warper accepts */
             if (make_frame(r, &dst, FZ_FRAMES_MAX, fmt, cfg.width, cfg.height, 0, scene, 0, 0) &&
