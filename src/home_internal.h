@@ -50,6 +50,9 @@ typedef struct home__refine_points {
     int n, capacity;
 } home__refine_points;
 
+/* Regions of the refinement's identity test at most (its grid: src/refine_internal.h). */
+#define HOME__MAX_REGIONS 64
+
 /* refine.c: per-frame snapshots (arena-backed): template points of the last two frames, the
  * pyramid of the last one */
 typedef struct home__refine_state {
@@ -63,6 +66,7 @@ typedef struct home__refine_state {
     home__refine_points tpl[2][HOME_REFINE_MAX_LEVELS];
     home__refine_points regions[2];   /* the strongest points of every region of a grid at
                                          region_level, for the identity test (x, y, t only) */
+    unsigned char region_faint[2][HOME__MAX_REGIONS]; /* per region: its points are faint */
     int region_level;
     const home__refine_kernels *rk;   /* SIMD backend, as cfg.simd */
     void *scratch;

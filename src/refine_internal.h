@@ -19,6 +19,7 @@
 #define REGION_WEAK_SCORE 2  /* ... or, where none pass the level's floor, the blocks with a score
                                 |gx| + |gy| (2x central differences) of at least this */
 #define REGION_CAPACITY (REGIONS_X * REGIONS_Y * REGION_TOP)
+typedef char home__regions_fit[REGIONS_X * REGIONS_Y <= HOME__MAX_REGIONS ? 1 : -1];
 
 /* One refinement: the template, the estimate and the solver's state. */
 typedef struct home__refine_solver {

@@ -276,7 +276,8 @@ int home__refine_region_floor(int level)
 }
 
 static void select_region_points(const uint8_t *img, int w, int h, int level,
-                                 const uint16_t *cells, home__refine_points *out)
+                                 const uint16_t *cells, home__refine_points *out,
+                                 unsigned char *faint)
 {
     const int b = block_side(level);
     const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
@@ -305,6 +306,8 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
             out->y[r + j] = (int16_t)y;
         }
     }
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++)
+        faint[r] = key[r * REGION_TOP] > 0 && key[r * REGION_TOP] < floor_key;
     for (i = 0; i < REGION_CAPACITY; i++) {
         /* a region with blocks above the floor keeps only those */
         if (!key[i] || (key[i] < floor_key && key[i - i % REGION_TOP] >= floor_key)) continue;
@@ -349,7 +352,8 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
                           &st->tpl[slot][l]);
     l = st->region_level;
     select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
-    select_region_points(st->pyr[l], st->w[l], st->h[l], l, cells, &st->regions[slot]);
+    select_region_points(st->pyr[l], st->w[l], st->h[l], l, cells, &st->regions[slot],
+                         st->region_faint[slot]);
     st->slot_id[slot] = st->pyr_id;
     return st->pyr_id;
 }

@@ -27,15 +27,15 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
 {
     const home__refine_state *st = &ctx->refine;
     double cost[2][2][REGIONS_X * REGIONS_Y], gain[2], bias[2], hn[9], sigma, c, cost_h, cost_i;
-    int count[REGIONS_X * REGIONS_Y], faint[REGIONS_X * REGIONS_Y], e, i, k, r, votes = 0;
-    int wins = 0, clear_votes = 0, clear_wins = 0, fl, n4, floor;
+    int count[REGIONS_X * REGIONS_Y], e, i, k, r, votes = 0;
+    int wins = 0, clear_votes = 0, clear_wins = 0, fl, n4;
+    const unsigned char *faint = st->region_faint[slot]; /* frame A's, as its points */
     const home__refine_points *tp;
     float m[9];
     home__refine_solver s;
     *clear_share = 0.0;
     home__refine_solver_setup(ctx, slot, &s);
     fl = st->region_level;
-    floor = home__refine_region_floor(fl);
     tp = &st->regions[slot];
     if (tp->n < MIN_POINTS) return 0.0;
     n4 = (tp->n + LANES - 1) & ~(LANES - 1);
@@ -63,15 +63,10 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
     }
     memset(cost, 0, sizeof cost);
     memset(count, 0, sizeof count);
-    memset(faint, 0, sizeof faint);
     for (i = 0; i < tp->n; i++) {
-        const uint8_t *p = st->pyr[fl] + (ptrdiff_t)tp->y[i] * st->w[fl] + tp->x[i];
-        const int gx = p[1] - p[-1], gy = p[st->w[fl]] - p[-st->w[fl]];
         if (s.img_b[i] < 0.0f || s.img_b2[i] < 0.0f) continue;
         r = region_of(tp->x[i], tp->y[i], st->w[fl], st->h[fl]);
         count[r]++;
-        /* a region's points are all textured or all faint (select_region_points) */
-        faint[r] = (gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy) < floor;
         for (e = 0; e < 2; e++) {
             const double v = e ? s.img_b2[i] : s.img_b[i];
             for (k = 0; k < 2; k++)
