@@ -59,8 +59,6 @@ static inline double robust_cost(double r, double c)
 
 /* refine_snapshot.c: points a match-time scratch buffer holds */
 int home__refine_match_capacity(const home_config *cfg);
-/* The score |gx| + |gy| a region point of `level` needs to count as textured. */
-int home__refine_region_floor(int level);
 
 /* refine_solve.c */
 void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver *s);

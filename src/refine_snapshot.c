@@ -270,7 +270,8 @@ static void select_points(const home__refine_kernels *rk, const uint8_t *img, in
  * region with none, above REGION_WEAK_SCORE (a horizon in fog). A moving object's texture fills
  * the template's capacity, and the static background then has no say; per region it keeps its
  * own. */
-int home__refine_region_floor(int level)
+/* The score |gx| + |gy| a region point of `level` needs to count as textured. */
+static int region_floor(int level)
 {
     return (score_floor(level) / 2 + 1) * 2;
 }
@@ -282,7 +283,7 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
     const int b = block_side(level);
     const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
     const int log2b = b == 4 ? 2 : b == 2 ? 1 : 0;
-    const int floor_key = home__refine_region_floor(level) << 4, weak_key = REGION_WEAK_SCORE << 4;
+    const int floor_key = region_floor(level) << 4, weak_key = REGION_WEAK_SCORE << 4;
     int16_t key[REGION_CAPACITY];
     int bx, by, i, j, r, n = 0;
     for (i = 0; i < REGION_CAPACITY; i++) key[i] = 0;
