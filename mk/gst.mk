@@ -66,9 +66,9 @@ $(BUILD)/obj/gst-static/gsthomestab.o: examples/gst/gsthomestab.c
 
 $(BUILD)/obj/gst-static/test_gst.o: tests/test_gst.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_GST) $(SAN) $(CFLAGS) $(DEPFLAGS) -c $< -o $@
+	$(CC) $(CFLAGS_GST) -Itests/support $(SAN) $(CFLAGS) $(DEPFLAGS) -c $< -o $@
 
-$(GST_TESTS): $(BUILD)/obj/gst-static/test_gst.o $(BUILD)/obj/gst-static/gsthomestab.o $(LIB)
+$(GST_TESTS): $(BUILD)/obj/gst-static/test_gst.o $(BUILD)/obj/gst-static/gsthomestab.o $(RUNNER_OBJ) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) $(GST_LIBS) $(shell $(PKG_CONFIG) --libs gstreamer-check-1.0)
 
