@@ -1,10 +1,11 @@
 /* GstHarness tests of the homestab element (examples/gst/gsthomestab.c, compiled in and
  * registered as a static plugin): frames out = frames in, the latency it reports, flushes,
  * renegotiation, refused caps, timestamps, the four formats against each other, statistics
- * messages, settings changed while streaming. One line per test, then "N passed, N failed".
+ * messages, settings changed while streaming, frames from a small upstream pool. One line per test, then "N passed, N failed".
  * Headless: no plugins but GStreamer's core and this one are loaded. */
 #include <gst/gst.h>
 #include <gst/check/gstharness.h>
+#include <gst/video/video.h>
 #include <math.h>
 #include <string.h>
 #include "test.h"
@@ -458,11 +459,68 @@ void test_gst_invalid_settings_refused(void)
     gst_harness_teardown(hh);
 }
 
+/* Frames from an upstream pool of 3 buffers with a lookahead of 8: the element copies what it
+ * holds, so the pool never runs dry (a non-blocking acquire fails when it does), and the output
+ * is the same as from plain buffers. */
+void test_gst_pooled_input_copied(void)
+{
+    enum { N = 20 };
+    GstHarness *hh = harness("NV12", W, H);
+    GstBufferPool *pool = gst_video_buffer_pool_new();
+    GstStructure *config = gst_buffer_pool_get_config(pool);
+    GstCaps *caps = gst_caps_from_string("video/x-raw,format=NV12,width=192,height=144,framerate=30/1");
+    GstBuffer *ref[N], *out[N];
+    GstBufferPoolAcquireParams dontwait = {GST_FORMAT_UNDEFINED, 0, 0, GST_BUFFER_POOL_ACQUIRE_FLAG_DONTWAIT, {0}};
+    int i, n, acquired = 0, same = 1;
+    gst_buffer_pool_config_set_params(config, caps, W * H * 3 / 2, 0, 3);
+    CHECK(gst_buffer_pool_set_config(pool, config));
+    CHECK(gst_buffer_pool_set_active(pool, TRUE));
+    g_object_set(hh->element, "lookahead", 8, NULL);
+    for (i = 0; i < N; i++) {
+        GstBuffer *b = NULL, *frame = make_frame("NV12", W, H, i);
+        GstMapInfo map;
+        if (gst_buffer_pool_acquire_buffer(pool, &b, &dontwait) != GST_FLOW_OK) { gst_buffer_unref(frame); break; }
+        acquired++;
+        gst_buffer_map(frame, &map, GST_MAP_READ);
+        gst_buffer_fill(b, 0, map.data, map.size);
+        gst_buffer_unmap(frame, &map);
+        GST_BUFFER_PTS(b) = GST_BUFFER_PTS(frame);
+        GST_BUFFER_DURATION(b) = GST_BUFFER_DURATION(frame);
+        gst_buffer_unref(frame);
+        CHECK_EQ_INT(gst_harness_push(hh, b), GST_FLOW_OK);
+    }
+    CHECK_EQ_INT(acquired, N);
+    CHECK(gst_harness_push_event(hh, gst_event_new_eos()));
+    n = pull_all(hh, out, N);
+    gst_harness_teardown(hh);
+    CHECK_EQ_INT(n, N);
+    hh = harness("NV12", W, H);
+    g_object_set(hh->element, "lookahead", 8, NULL);
+    CHECK_EQ_INT(push_frames(hh, "NV12", W, H, 0, N), GST_FLOW_OK);
+    CHECK(gst_harness_push_event(hh, gst_event_new_eos()));
+    CHECK_EQ_INT(pull_all(hh, ref, N), N);
+    gst_harness_teardown(hh);
+    for (i = 0; i < n; i++) {
+        GstMapInfo a, b;
+        gst_buffer_map(ref[i], &a, GST_MAP_READ);
+        gst_buffer_map(out[i], &b, GST_MAP_READ);
+        same &= a.size == b.size && !memcmp(a.data, b.data, a.size) && GST_BUFFER_PTS(ref[i]) == GST_BUFFER_PTS(out[i]);
+        gst_buffer_unmap(out[i], &b);
+        gst_buffer_unmap(ref[i], &a);
+    }
+    CHECK(same);
+    unref_all(out, n);
+    unref_all(ref, N);
+    gst_buffer_pool_set_active(pool, FALSE);
+    gst_object_unref(pool);
+    gst_caps_unref(caps);
+}
+
 #define TEST_LIST(X) \
     X(gst_frames_out_equal_in_causal) X(gst_frames_out_equal_in_lookahead8) X(gst_latency) \
     X(gst_flush_drops_held) X(gst_renegotiation) X(gst_refuses_caps) X(gst_timestamps_preserved) \
     X(gst_still_identity_every_format) X(gst_formats_agree) X(gst_statistics_messages) \
-    X(gst_settings_while_streaming) X(gst_invalid_settings_refused)
+    X(gst_settings_while_streaming) X(gst_invalid_settings_refused) X(gst_pooled_input_copied)
 
 #define DECLARE(name) void test_##name(void);
 TEST_LIST(DECLARE)

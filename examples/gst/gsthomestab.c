@@ -15,8 +15,8 @@
  *
  * Memory: the stabiliser's arena is allocated once per configuration (the library itself never
  * allocates). Held frames that come from an upstream buffer pool (a camera's few buffers) are
- * copied into the element's own pool of lookahead + 1 buffers, so upstream gets its buffers back
- * at once; other input buffers are held by reference. */
+ * copied into the element's own pool (lookahead + 1 buffers at most, allocated as first needed),
+ * so upstream gets its buffers back at once; other input buffers are held by reference. */
 #include <gst/gst.h>
 #include <gst/video/video.h>
 #include <gst/video/gstvideofilter.h>
@@ -205,8 +205,9 @@ static void release_all(GstHomeStab *self)
     self->pushed = 0;
 }
 
-/* The pool held frames are copied into: lookahead + 1 buffers of the negotiated layout (no
- * video meta, so the copies map by the caps' default strides). */
+/* The pool held frames are copied into: buffers of the negotiated layout (no video meta, so
+ * the copies map by the caps' default strides), allocated as first needed (never when upstream
+ * has no pool) and kept: lookahead + 1 at most are out at a time. */
 static gboolean make_copy_pool(GstHomeStab *self, GstCaps *caps, const GstVideoInfo *info)
 {
     GstStructure *config;
@@ -214,8 +215,7 @@ static gboolean make_copy_pool(GstHomeStab *self, GstCaps *caps, const GstVideoI
     if (self->cfg.lookahead == 0) return TRUE;
     self->copy_pool = gst_video_buffer_pool_new();
     config = gst_buffer_pool_get_config(self->copy_pool);
-    gst_buffer_pool_config_set_params(config, caps, (guint)GST_VIDEO_INFO_SIZE(info),
-                                      (guint)self->cfg.lookahead + 1, 0);
+    gst_buffer_pool_config_set_params(config, caps, (guint)GST_VIDEO_INFO_SIZE(info), 0, 0);
     if (!gst_buffer_pool_set_config(self->copy_pool, config) ||
         !gst_buffer_pool_set_active(self->copy_pool, TRUE)) {
         release_copy_pool(self);
@@ -402,20 +402,23 @@ static GstFlowReturn apply_changed_settings(GstHomeStab *self)
     return GST_FLOW_OK;
 }
 
-/* The frame to hold: the input itself, or a copy when it belongs to an upstream pool. */
+/* The frame to hold: the input itself, or a copy when it belongs to an upstream pool (the
+ * input is released then; in_frame, its mapping, keeps its own reference). NULL when no copy
+ * could be made, the input released too. */
 static GstBuffer *frame_to_hold(GstHomeStab *self, GstBuffer *input, GstVideoFrame *in_frame)
 {
     GstVideoFrame copy_frame;
     GstBuffer *copy = NULL;
     if (!input->pool || !self->copy_pool) return input;
-    if (gst_buffer_pool_acquire_buffer(self->copy_pool, &copy, NULL) != GST_FLOW_OK) return NULL;
-    if (!gst_video_frame_map(&copy_frame, &GST_VIDEO_FILTER(self)->in_info, copy, GST_MAP_WRITE)) {
+    if (gst_buffer_pool_acquire_buffer(self->copy_pool, &copy, NULL) == GST_FLOW_OK &&
+        gst_video_frame_map(&copy_frame, &GST_VIDEO_FILTER(self)->in_info, copy, GST_MAP_WRITE)) {
+        gst_video_frame_copy(&copy_frame, in_frame);
+        gst_video_frame_unmap(&copy_frame);
+        gst_buffer_copy_into(copy, input, GST_BUFFER_COPY_FLAGS | GST_BUFFER_COPY_TIMESTAMPS, 0, -1);
+    } else if (copy) {
         gst_buffer_unref(copy);
-        return NULL;
+        copy = NULL;
     }
-    gst_video_frame_copy(&copy_frame, in_frame);
-    gst_video_frame_unmap(&copy_frame);
-    gst_buffer_copy_into(copy, input, GST_BUFFER_COPY_FLAGS | GST_BUFFER_COPY_TIMESTAMPS, 0, -1);
     gst_buffer_unref(input);
     return copy;
 }
