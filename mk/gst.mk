@@ -28,7 +28,9 @@ GST_SKIPPED :=
 ifeq ($(GST_HAVE),1)
 BINS += $(GST_PLUGIN)
 ifeq ($(GST_HAVE_CHECK),1)
+# (BINS took TEST_BINS's value in mk/tests.mk, before this: named here too, so `make` builds it)
 TEST_BINS += $(GST_TESTS)
+BINS += $(GST_TESTS)
 else
 GST_SKIPPED += home-gst-tests (gstreamer-check-1.0 not found: apt-get install libgstreamer1.0-dev)
 endif
