@@ -1,9 +1,14 @@
 // eis-libcamera: live electronic image stabilisation over libcamera (C++17).
 // Acquire the camera, configure one stream (validate; an Adjusted configuration is reported and
-// used), allocate buffers with FrameBufferAllocator, queue one request per buffer; completed
-// requests are handed from the camera thread to the main thread through a queue, stabilised
-// there with libhome, written as Y4M (I420) and reused. A clean stop cancels and frees all.
-// Builds against Debian 12's libcamera 0.0.3 and current Raspberry Pi OS libcamera.
+// used), allocate buffers with FrameBufferAllocator - or, where it fails (no /dev/dma_heap and no
+// /dev/udmabuf, as on some boards and in containers), in application memory: one memfd per
+// buffer, which pipeline handlers that fill buffers from the CPU (the virtual camera) accept -
+// and queue one request per buffer; completed requests are handed from the camera thread to the
+// main thread through a queue, stabilised there with libhome, written as Y4M (I420) and reused.
+// A frame byte-identical to the one before (a source repeating frames: libcamera's virtual
+// camera shows each image 4 times) is not registered again: it is written as a copy of that
+// frame's stabilised output. A clean stop cancels and frees all.
+// Builds against Debian 12's libcamera 0.0.3 and libcamera 0.4 to 0.7 (Raspberry Pi OS).
 // Exit: 0 done, 2 usage/setup error, 3 camera lost or failed while streaming, 4 no camera.
 #include "eis_common.h"
 #include "home_stab.h"
@@ -11,6 +16,7 @@
 #include <libcamera/libcamera.h>
 
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <condition_variable>
@@ -33,21 +39,28 @@ std::atomic<bool> stop_requested{false};
 void on_signal(int) { stop_requested = true; }
 
 struct Options {
-    std::string camera_id, output;
+    std::string camera_id, output, raw_output;
     unsigned width = 640, height = 480;
     std::string format = "yu12";
     long frames = 0;
-    float margin = 0.10f, smoothing = 0.0f;   // 0: automatic (see home_stab_config)
+    float margin_x = 0.10f, margin_y = 0.10f, smoothing = 0.0f;   // 0: automatic (home_stab_config)
     int lookahead = EIS_LIVE_LOOKAHEAD;
-    bool quiet = false;
+    bool quiet = false, keep_repeats = false;
 };
 
 void usage(FILE *f)
 {
     std::fprintf(f, "usage: eis-libcamera [--camera ID|INDEX] [--size WxH] [--format yu12|nv12|yuyv]\n"
-                    "       [--frames N] [--margin F] [--smoothing F] [--lookahead N] [--output FILE.y4m|-]\n"
+                    "       [--frames N] [--margin F] [--margin-x F] [--margin-y F] [--smoothing F]\n"
+                    "       [--lookahead N] [--output FILE.y4m|-] [--raw-output FILE.y4m] [--keep-repeats]\n"
                     "       [--quiet] [--list]\n"
-                    "Exit: 0 done, 2 usage/setup error, 3 camera lost or failed, 4 no camera.\n");
+                    "  --frames N        stop after N captured frames (default: until interrupted)\n"
+                    "  --output F        the stabilised frames as Y4M (I420); --raw-output F: as captured\n"
+                    "  --keep-repeats    register a frame identical to the one before as any other (by\n"
+                    "                    default it is written as a copy of that frame's stabilised output)\n"
+                    "Buffers come from the camera's FrameBufferAllocator or, where that fails, from\n"
+                    "memfd application memory. Exit: 0 done, 2 usage/setup error, 3 camera lost or\n"
+                    "failed, 4 no camera.\n");
 }
 
 int stab_format(const PixelFormat &f)
@@ -86,11 +99,58 @@ private:
     std::deque<Request *> queue_;
 };
 
-// A dmabuf mapped once, whole; each plane is base + offset.
+// A dmabuf (or memfd) mapped once, whole; each plane is base + offset.
 struct Mapping {
     void *base = MAP_FAILED;
     size_t length = 0;
 };
+
+// Bytes of each plane of a frame as libcamera lays it out for a stream of luma stride `stride`:
+// YUV420 Y, U, V; NV12 Y, UV; YUYV one plane.
+std::vector<size_t> plane_bytes(int format, unsigned stride, unsigned height)
+{
+    const size_t luma = (size_t)stride * height;
+    if (format == HOME_STAB_YUYV) return {luma};
+    if (format == HOME_STAB_NV12) return {luma, (size_t)stride * (height / 2)};
+    return {luma, (size_t)(stride / 2) * (height / 2), (size_t)(stride / 2) * (height / 2)};
+}
+
+// The fallback when FrameBufferAllocator fails: `count` buffers in application memory, each a
+// memfd with the planes one after the other (as the allocators lay them out in one dmabuf).
+// A pipeline handler that fills buffers from the CPU (the virtual camera, a software ISP) maps
+// them like dmabufs; one that hands them to a V4L2 device needs real dmabufs and fails to queue
+// them. Empty on failure, with errno set.
+std::vector<std::unique_ptr<FrameBuffer>> memfd_buffers(int format, unsigned stride, unsigned height,
+                                                         size_t frame_size, unsigned count)
+{
+    std::vector<std::unique_ptr<FrameBuffer>> buffers;
+    const std::vector<size_t> sizes = plane_bytes(format, stride, height);
+    size_t total = 0;
+    for (size_t s : sizes) total += s;
+    total = std::max(total, frame_size);
+    for (unsigned i = 0; i < count; i++) {
+        int fd = memfd_create("eis-libcamera", MFD_CLOEXEC);
+        if (fd < 0 || ftruncate(fd, (off_t)total) < 0) {
+            int err = errno;
+            if (fd >= 0) close(fd);
+            errno = err;
+            return {};
+        }
+        SharedFD shared(std::move(fd));   // owns the descriptor; the planes share it
+        std::vector<FrameBuffer::Plane> planes;
+        size_t offset = 0;
+        for (size_t s : sizes) {
+            FrameBuffer::Plane plane;
+            plane.fd = shared;
+            plane.offset = (unsigned)offset;
+            plane.length = (unsigned)s;
+            planes.push_back(plane);
+            offset += s;
+        }
+        buffers.push_back(std::make_unique<FrameBuffer>(planes));
+    }
+    return buffers;
+}
 
 } // namespace
 
@@ -104,16 +164,20 @@ int main(int argc, char **argv)
         if (a == "--help") { usage(stdout); return 0; }
         if (a == "--quiet") { o.quiet = true; continue; }
         if (a == "--list") { list_only = true; continue; }
+        if (a == "--keep-repeats") { o.keep_repeats = true; continue; }
         if (!v) { std::fprintf(stderr, "eis-libcamera: %s needs a value (see --help)\n", a.c_str()); return 2; }
         i++;
         char *end = nullptr;
         bool bad = false;
         if (a == "--camera") o.camera_id = v;
         else if (a == "--output") o.output = v;
+        else if (a == "--raw-output") o.raw_output = v;
         else if (a == "--format") { o.format = v; bad = o.format != "yu12" && o.format != "nv12" && o.format != "yuyv"; }
         else if (a == "--size") bad = std::sscanf(v, "%ux%u", &o.width, &o.height) != 2 || o.width < 32 || o.height < 32;
         else if (a == "--frames") { o.frames = std::strtol(v, &end, 10); bad = *end || o.frames < 0; }
-        else if (a == "--margin") { o.margin = std::strtof(v, &end); bad = *end; }
+        else if (a == "--margin") { o.margin_x = o.margin_y = std::strtof(v, &end); bad = *end; }
+        else if (a == "--margin-x") { o.margin_x = std::strtof(v, &end); bad = *end; }
+        else if (a == "--margin-y") { o.margin_y = std::strtof(v, &end); bad = *end; }
         else if (a == "--smoothing") { o.smoothing = std::strtof(v, &end); bad = *end; }
         else if (a == "--lookahead") { o.lookahead = (int)std::strtol(v, &end, 10); bad = *end || o.lookahead < 0 || o.lookahead > HOME_STAB_MAX_LOOKAHEAD; }
         else { std::fprintf(stderr, "eis-libcamera: unknown option %s (see --help)\n", a.c_str()); return 2; }
@@ -125,7 +189,12 @@ int main(int argc, char **argv)
 
     auto cm = std::make_unique<CameraManager>();
     if (int ret = cm->start()) {
-        std::fprintf(stderr, "eis-libcamera: cannot start the camera manager: %s\n", std::strerror(-ret));
+        // without udev, libcamera enumerates media devices through sysfs, and fails where the
+        // kernel has no media bus (no camera driver loaded: containers, CI machines)
+        const bool no_media_bus = access("/sys/bus/media/devices", F_OK) != 0;
+        std::fprintf(stderr, "eis-libcamera: cannot start the camera manager: %s%s\n", std::strerror(-ret),
+                     no_media_bus ? " (/sys/bus/media/devices is missing: no media device driver is loaded; "
+                                    "see docs/libcamera.md)" : "");
         return 2;
     }
     std::vector<std::shared_ptr<Camera>> cameras = cm->cameras();
@@ -159,6 +228,7 @@ int main(int argc, char **argv)
     int rc = 0;
     std::unique_ptr<CameraConfiguration> config = camera->generateConfiguration({StreamRole::Viewfinder});
     std::unique_ptr<FrameBufferAllocator> allocator;
+    std::vector<std::unique_ptr<FrameBuffer>> own_buffers;   // the memfd fallback's
     std::vector<std::unique_ptr<Request>> requests;
     std::map<int, Mapping> maps;   // by dmabuf fd
     CompletionQueue completed;
@@ -166,25 +236,34 @@ int main(int argc, char **argv)
     home_stab *stab = nullptr;
     void *arena = nullptr;
     std::vector<std::vector<uint8_t>> ring;
+    std::vector<int> repeats;   // per ring slot: captured repeats of that frame not yet written
     std::vector<uint8_t> warped, i420;
-    FILE *out = nullptr;
+    FILE *out = nullptr, *raw_out = nullptr;
     Stream *stream = nullptr;
     int format = 0;
     unsigned width = 0, height = 0, stride = 0;
-    long pushed = 0, written = 0, failed_frames = 0;
+    long captured = 0, pushed = 0, repeated = 0, written = 0, failed_frames = 0;
+    long shown = -1;   // the newest frame (push index) whose stabilised output was written
 
-    auto show = [&](const home_stab_output &so) -> bool {
-        home_stab_image src, dst;
-        eis_frame_view(format, (int)width, (int)height, ring[so.frame % ring.size()].data(), &src);
-        eis_frame_view(format, (int)width, (int)height, warped.data(), &dst);
-        if (home_stab_warp(so.warp, &src, &dst) != HOME_OK) return false;
-        if (!out) return true;
-        eis_to_i420(format, (int)width, (int)height, warped.data(), i420.data(), 0, 0);
-        if (std::fputs("FRAME\n", out) < 0 || std::fwrite(i420.data(), 1, i420.size(), out) != i420.size()) {
+    auto write_i420 = [&](FILE *f, const uint8_t *frame) -> bool {
+        eis_to_i420(format, (int)width, (int)height, frame, i420.data(), 0, 0);
+        if (std::fputs("FRAME\n", f) < 0 || std::fwrite(i420.data(), 1, i420.size(), f) != i420.size()) {
             std::fprintf(stderr, "eis-libcamera: write error\n");
             return false;
         }
-        written++;
+        return true;
+    };
+    // warp the frame due and write it, once and once more per repeat of it captured so far
+    auto show = [&](const home_stab_output &so) -> bool {
+        home_stab_image src, dst;
+        const size_t slot = (size_t)so.frame % ring.size();
+        eis_frame_view(format, (int)width, (int)height, ring[slot].data(), &src);
+        eis_frame_view(format, (int)width, (int)height, warped.data(), &dst);
+        if (home_stab_warp(so.warp, &src, &dst) != HOME_OK) return false;
+        shown = so.frame;
+        for (int copies = 1 + repeats[slot]; out && copies > 0; copies--, written++)
+            if (!write_i420(out, warped.data())) return false;
+        repeats[slot] = 0;
         return true;
     };
 
@@ -217,7 +296,8 @@ int main(int argc, char **argv)
 
         home_stab_config cfg;
         int st = home_stab_default_config(&cfg, (int)width, (int)height);
-        cfg.margin_x = cfg.margin_y = o.margin;
+        cfg.margin_x = o.margin_x;
+        cfg.margin_y = o.margin_y;
         cfg.smoothing = o.smoothing;
         cfg.lookahead = o.lookahead;
         cfg.clock = eis_now_ms;
@@ -231,6 +311,7 @@ int main(int argc, char **argv)
         }
         const size_t fbytes = eis_frame_bytes(format, (int)width, (int)height);
         ring.assign((size_t)cfg.lookahead + 1, std::vector<uint8_t>(fbytes));
+        repeats.assign(ring.size(), 0);
         warped.resize(fbytes);
         i420.resize((size_t)width * height * 3 / 2);
         if (!o.output.empty()) {
@@ -238,16 +319,37 @@ int main(int argc, char **argv)
             if (!out) { std::fprintf(stderr, "eis-libcamera: cannot write %s\n", o.output.c_str()); rc = 2; break; }
             std::fprintf(out, "YUV4MPEG2 W%u H%u F30:1 Ip A1:1 C420jpeg\n", width, height);
         }
+        if (!o.raw_output.empty()) {
+            raw_out = std::fopen(o.raw_output.c_str(), "wb");
+            if (!raw_out) { std::fprintf(stderr, "eis-libcamera: cannot write %s\n", o.raw_output.c_str()); rc = 2; break; }
+            std::fprintf(raw_out, "YUV4MPEG2 W%u H%u F30:1 Ip A1:1 C420jpeg\n", width, height);
+        }
 
         allocator = std::make_unique<FrameBufferAllocator>(camera);
-        if (allocator->allocate(stream) < 0) { std::fprintf(stderr, "eis-libcamera: cannot allocate buffers\n"); rc = 2; break; }
-        for (const std::unique_ptr<FrameBuffer> &buffer : allocator->buffers(stream)) {
+        std::vector<FrameBuffer *> buffers;
+        if (allocator->allocate(stream) > 0) {
+            for (const std::unique_ptr<FrameBuffer> &buffer : allocator->buffers(stream)) buffers.push_back(buffer.get());
+        } else {
+            allocator.reset();
+            own_buffers = memfd_buffers(format, stride, height, sc.frameSize, std::max(sc.bufferCount, 4u));
+            if (own_buffers.empty()) {
+                std::fprintf(stderr, "eis-libcamera: cannot allocate buffers, from the camera nor in memory (memfd: %s)\n",
+                             std::strerror(errno));
+                rc = 2;
+                break;
+            }
+            if (!o.quiet)
+                std::fprintf(stderr, "eis-libcamera: the camera's buffer allocator failed (no /dev/dma_heap or "
+                                     "/dev/udmabuf?): %zu buffers in application memory (memfd)\n", own_buffers.size());
+            for (const std::unique_ptr<FrameBuffer> &buffer : own_buffers) buffers.push_back(buffer.get());
+        }
+        for (FrameBuffer *buffer : buffers) {
             for (const FrameBuffer::Plane &plane : buffer->planes()) {
                 Mapping &m = maps[plane.fd.get()];
                 m.length = std::max(m.length, (size_t)plane.offset + plane.length);
             }
             std::unique_ptr<Request> request = camera->createRequest();
-            if (!request || request->addBuffer(stream, buffer.get())) { std::fprintf(stderr, "eis-libcamera: cannot create a request\n"); rc = 2; break; }
+            if (!request || request->addBuffer(stream, buffer)) { std::fprintf(stderr, "eis-libcamera: cannot create a request\n"); rc = 2; break; }
             requests.push_back(std::move(request));
         }
         if (rc) break;
@@ -261,12 +363,18 @@ int main(int argc, char **argv)
         if (camera->start()) { std::fprintf(stderr, "eis-libcamera: cannot start the camera\n"); rc = 2; break; }
         started = true;
         for (std::unique_ptr<Request> &r : requests)
-            if (camera->queueRequest(r.get()) < 0) { std::fprintf(stderr, "eis-libcamera: cannot queue a request\n"); rc = 3; break; }
+            if (camera->queueRequest(r.get()) < 0) {
+                std::fprintf(stderr, "eis-libcamera: cannot queue a request%s\n",
+                             own_buffers.empty() ? "" : " (this camera needs dmabufs: memfd buffers serve only "
+                                                        "pipeline handlers that fill buffers from the CPU)");
+                rc = 3;
+                break;
+            }
         if (rc) break;
 
         double since = eis_now_ms(nullptr), ms_reg = 0;
         long frames_since = 0;
-        while (!stop_requested && (o.frames == 0 || pushed < o.frames)) {
+        while (!stop_requested && (o.frames == 0 || captured < o.frames)) {
             Request *request = completed.pop(2000);
             if (!request) { std::fprintf(stderr, "eis-libcamera: no frame within 2 s: camera stalled\n"); rc = 3; break; }
             if (request->status() == Request::RequestCancelled) break;   // the camera is stopping
@@ -275,7 +383,7 @@ int main(int argc, char **argv)
             bool ok = meta.status == FrameMetadata::FrameSuccess;
             if (ok) {
                 // copy the planes out (respecting the stride), then give the buffer back at once
-                uint8_t *slot = ring[pushed % ring.size()].data();
+                uint8_t *slot = ring[(size_t)pushed % ring.size()].data();
                 home_stab_image im;
                 eis_frame_view(format, (int)width, (int)height, slot, &im);
                 const auto &planes = buffer->planes();
@@ -300,10 +408,24 @@ int main(int argc, char **argv)
                             eis_copy_rows(im.plane[2], (size_t)im.stride[2], base + cstride * (height / 2), cstride, (size_t)im.stride[2], (int)height / 2);
                     }
                 }
-                if (ok) {
+                if (ok) captured++;
+                if (ok && raw_out && !write_i420(raw_out, slot)) rc = 2;
+                if (ok && !rc && !o.keep_repeats && pushed > 0 &&
+                    std::memcmp(slot, ring[(size_t)(pushed - 1) % ring.size()].data(), fbytes) == 0) {
+                    // a repeat of the newest frame: written again if its output already was,
+                    // else with it
+                    repeated++;
+                    if (shown == pushed - 1) {
+                        if (out && !write_i420(out, warped.data())) rc = 2;
+                        written += out ? 1 : 0;
+                    } else {
+                        repeats[(size_t)(pushed - 1) % ring.size()]++;
+                    }
+                } else if (ok && !rc) {
                     home_stab_output so;
                     int st2 = home_stab_push(stab, &im, &so);
                     if (st2 != HOME_OK) { std::fprintf(stderr, "eis-libcamera: stabiliser: %s\n", home_strerror(st2)); rc = 2; }
+                    repeats[(size_t)pushed % ring.size()] = 0;
                     pushed++;
                     frames_since++;
                     ms_reg += so.ms_register;
@@ -335,15 +457,17 @@ int main(int argc, char **argv)
         if (m.base != MAP_FAILED) munmap(m.base, m.length);
     if (allocator && stream) allocator->free(stream);
     allocator.reset();
+    own_buffers.clear();
     config.reset();
     camera->release();
     camera.reset();
     cm->stop();
     if (!o.quiet)
-        std::fprintf(stderr, "eis-libcamera: %ld frames stabilised, %ld written, %ld failed%s\n", pushed, written,
-                     failed_frames, stop_requested ? ", stopped by signal" : "");
+        std::fprintf(stderr, "eis-libcamera: %ld frames captured (%ld registered, %ld repeats), %ld written, %ld failed%s\n",
+                     captured, pushed, repeated, written, failed_frames, stop_requested ? ", stopped by signal" : "");
     if (out && std::fflush(out) != 0) rc = 2;
-    if (out && out != stdout) std::fclose(out);
+    if (out && out != stdout && std::fclose(out) != 0) rc = 2;
+    if (raw_out && std::fclose(raw_out) != 0) rc = 2;
     std::free(arena);
     return rc;
 }
