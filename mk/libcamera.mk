@@ -24,3 +24,25 @@ $(LCV_EIS): examples/eis-libcamera.cpp examples/eis_common.h $(BUILD)/obj/exampl
 		$$($(PKG_CONFIG) --cflags libcamera) $< $(BUILD)/obj/examples/eis_common.o $(LIB) -o $@ $(LDFLAGS_APP) \
 		$$($(PKG_CONFIG) --libs libcamera) -Wl,-rpath,$(abspath $(LCV))/prefix/lib -pthread
 
+# The rpicam-apps post-processing stage home_eis (examples/rpicam/, docs/libcamera.md): built by
+# `make rpicam-stage` (and by `make` when RPICAM_APPS_DIR is set) from an rpicam-apps source tree's
+# headers - rpicam-apps is in no package registry, so nothing here builds it otherwise - with
+# Boost's headers (libboost-dev) and the libcamera pkg-config finds (RPICAM_PKG_CONFIG_PATH puts
+# another first, e.g. $(LCV)/prefix/lib/pkgconfig). It links the PIC build of the library
+# (mk/gst.mk) and leaves rpicam-apps' symbols to rpicam-vid, which loads it.
+RPICAM_APPS_DIR ?=
+RPICAM_PKG_CONFIG_PATH ?=
+RPICAM_STAGE := $(BUILD)/lib/rpicam-apps-postproc/home_eis.so
+.PHONY: rpicam-stage
+ifneq ($(RPICAM_APPS_DIR),)
+BINS += $(RPICAM_STAGE)
+endif
+rpicam-stage: $(RPICAM_STAGE)
+
+$(RPICAM_STAGE): examples/rpicam/home_eis_stage.cpp include/home_stab.h include/home.h $(GST_PIC_LIB)
+	@if [ ! -f "$(RPICAM_APPS_DIR)/post_processing_stages/post_processing_stage.hpp" ]; then \
+		echo "rpicam-stage: set RPICAM_APPS_DIR to an rpicam-apps source tree (git clone https://github.com/raspberrypi/rpicam-apps.git)"; exit 2; fi
+	@mkdir -p $(dir $@)
+	$(if $(RPICAM_PKG_CONFIG_PATH),export PKG_CONFIG_PATH=$(RPICAM_PKG_CONFIG_PATH);) \
+	$(CXX) -std=c++17 $(OPT) -g -Wall -Wextra -Werror -fPIC -shared -Iinclude -I$(RPICAM_APPS_DIR) \
+		$$($(PKG_CONFIG) --cflags libcamera) $< $(GST_PIC_LIB) -o $@ $(LDFLAGS) -lm
