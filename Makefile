@@ -36,8 +36,8 @@ TEST_BINS :=
 .PHONY: all test demo golden install clean
 
 # the library (lib), the programs on it (programs), the test binaries (tests), speed and
-# accuracy measurements (bench), the hardening tools (analysis)
-include mk/lib.mk mk/programs.mk mk/tests.mk mk/bench.mk mk/analysis.mk
+# accuracy measurements (bench), the hardening tools (analysis), the bare-metal build (baremetal)
+include mk/lib.mk mk/programs.mk mk/tests.mk mk/bench.mk mk/analysis.mk mk/baremetal.mk
 
 all: $(LIB) $(BINS)
 
