@@ -36,9 +36,10 @@ TEST_BINS :=
 .PHONY: all test demo golden install clean
 
 # the library (lib), the programs on it (programs), the test binaries (tests), speed and
-# accuracy measurements (bench), the hardening tools (analysis), the GStreamer plugin (gst),
-# libcamera's virtual camera and the rpicam-apps stage (libcamera)
-include mk/lib.mk mk/programs.mk mk/tests.mk mk/bench.mk mk/analysis.mk mk/gst.mk mk/libcamera.mk
+# accuracy measurements (bench), the hardening tools (analysis), the bare-metal build (baremetal),
+# the GStreamer plugin (gst), libcamera's virtual camera and the rpicam-apps stage (libcamera)
+include mk/lib.mk mk/programs.mk mk/tests.mk mk/bench.mk mk/analysis.mk mk/baremetal.mk \
+	mk/gst.mk mk/libcamera.mk
 
 all: $(LIB) $(BINS)
 

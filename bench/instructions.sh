@@ -4,7 +4,7 @@
 # else the machine is doing. Each count is (N=3 frames) - (N=1 frame), halved, so set-up and
 # the first frame's work cancel out. The Cortex-A72 column assumes the aarch64 NEON build runs
 # about as many instructions as the x86 SSE2 build (both 128-bit) at an IPC of 1.5 at 1.5 GHz:
-# an estimate, not a measurement.
+# an estimate, not a measurement; `make bench-arm` counts ARM's own instructions (docs/speed.md).
 set -u
 BUILD=${BUILD:-build}
 bench=$BUILD/bin/home-bench
@@ -15,6 +15,7 @@ count() { # simd, method, n, downscale
 }
 per_frame() { local one three; one=$(count "$@" 1 "${4:-1}"); three=$(count "$1" "$2" 3 "${4:-1}"); echo $(( (three - one) / 2 )); }
 orb=$(per_frame none orb x 1)
+echo "(A72 column: x86 SSE2 instructions at IPC 1.5; ARM's own counts: make bench-arm)"
 printf '\n%-8s %-10s %14s %10s %14s\n' method preset frame_Ir "ORB/HOME" "A72 est. ms"
 printf '%-8s %-10s %14d %10s %14s\n' orb - "$orb" 1.00 -
 for simd in none sse avx2; do

@@ -79,3 +79,23 @@ BENCH_STAB_ARGS ?=
 .PHONY: bench-stab-realworld
 bench-stab-realworld: $(BUILD)/bin/home-stab $(BUILD)/bin/home-stab-clip eval-deps
 	$(EVAL_PYTHON) bench/stab/realworld.py --build $(BUILD) --cache $(EVAL_CACHE) $(BENCH_STAB_ARGS)
+
+# make bench-arm: executed aarch64 and armv7 (NEON) instructions per stage and per frame, for
+# the video registration (home-arm-frames) and the stabiliser (home-stab), counted by a qemu
+# TCG plugin (bench/arm/insn_count.c), with Cortex-A72/A76 time estimates from llvm-mca on the
+# hottest blocks (bench/arm/report.py), and the working set per frame against a Pi 4's L2
+# (aarch64; WORKING_SET=0 skips it). Needs qemu-user (the dynamically linked qemu-aarch64 and
+# qemu-arm: static ones cannot load plugins), the two cross compilers, llvm and apt-get source
+# access for qemu's plugin header (bench/arm/qemu_plugin_h.sh); about 9 minutes on 2 cores.
+# BENCH_ARM_SIZES, BENCH_ARM_ARCHES narrow the run; docs/speed.md "ARM instruction counts" has
+# the method and the numbers.
+ARM_FRAMES := $(BUILD)/bin/home-arm-frames
+BINS += $(ARM_FRAMES)
+$(ARM_FRAMES): $(BUILD)/obj/bench/arm/frames.o $(SUPPORT_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
+BENCH_ARM_SIZES ?= 640x360 1280x720 1920x1080
+BENCH_ARM_ARCHES ?= aarch64 armv7
+.PHONY: bench-arm
+bench-arm: $(BUILD)/bin/home-stab-clip
+	BUILD=$(BUILD) SIZES="$(BENCH_ARM_SIZES)" ARCHES="$(BENCH_ARM_ARCHES)" bash bench/arm/count.sh

@@ -19,11 +19,13 @@ $(BUILD)/obj/port/%_avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 # refinement's residual bins, the descriptors' radial profiles and J's statistics (four lanes)
 # are plain element-wise loops that -O2's cheapest vectoriser leaves scalar. Element-wise IEEE
 # operations in C99 mode (no contraction, no reassociation), so bit-identical output.
-$(BUILD)/obj/src/hough.o $(patsubst src/%.c,$(BUILD)/obj/src/%.o,$(wildcard src/refine*.c)) \
-$(BUILD)/obj/src/describe.o $(BUILD)/obj/src/pipeline.o: CFLAGS_LIB += -ftree-vectorize
 # The line fit (port/line_fit.h) works on four matches per step in separate lanes, element-wise
 # too; its sqrt vectorises only without errno (-fno-math-errno: same IEEE square roots).
-$(BUILD)/obj/src/homography.o $(BUILD)/obj/port/line_fit_%.o: CFLAGS_LIB += -ftree-vectorize -fno-math-errno
+# (The bare-metal build, mk/baremetal.mk, gives the same files the same flags.)
+LIB_VECTORISE := src/hough.c $(wildcard src/refine*.c) src/describe.c src/pipeline.c
+LIB_VECTORISE_NOERRNO := src/homography.c $(wildcard port/line_fit_*.c)
+$(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_VECTORISE)): CFLAGS_LIB += -ftree-vectorize
+$(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_VECTORISE_NOERRNO)): CFLAGS_LIB += -ftree-vectorize -fno-math-errno
 
 $(LIB): $(LIB_OBJ)
 	@mkdir -p $(dir $@)
