@@ -55,6 +55,8 @@ class TrustLibrary(Library):
 
     def grey(self, photo):
         path = self.cache / "photos" / photo.source / photo.file
+        if not (self.cache / "photos" / photo.source / photo.file.split("#")[0]).exists():
+            self.fetch([photo])                  # on demand: a clip built on its own
         if "#" in photo.file:
             container, k = photo.file.split("#")
             img = rcc_webp(self.cache / "photos" / photo.source / container, int(k))

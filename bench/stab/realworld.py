@@ -38,9 +38,14 @@ Metrics (luma):
              subpixel parabola peak) between consecutive frames' central 70 %; their shifts
              summed to a path per shot; RMS of what a sigma 4 Gaussian leaves (compare.jitter)
   ITF c70    mean PSNR of consecutive frames over their central 70 %
+  registration  (every clip with a truth) home-stab's own per-frame registrations, from its
+             --csv raw path at --lookahead 15, against the true camera motion: failures, and
+             of the frames reported ok or still the mean corner error and the share more than
+             2 px off (silent errors); --registration-only measures only this
 Sets: --set tuning | test | all (thresholds of the library are tuned on tuning only).
 Usage: python3 bench/stab/realworld.py [--set all] [--quick] [--clips NAME,...] [--jobs 2]
          [--build build] [--cache DIR] [--stab-args "..."] [--methods ...] [--out DIR]
+         [--registration-only]
 Rendered clips are cached in OUT/clips (default build/bench-stab-realworld); the report goes to
 stdout and OUT/results.md, the numbers to OUT/results.json.
 """
@@ -58,6 +63,7 @@ import types
 
 from pathlib import Path
 
+import csv
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
@@ -679,6 +685,40 @@ def cells(row, key, fmt, best=None):
     return " / ".join(out)
 
 
+def registration(stab, clip_y4m, truth, work, extra):
+    """home-stab's own registrations (--lookahead 15, its CSV) against the truth, frame to frame:
+    of the frames reported ok or still, the mean corner error and how many are more than 2 px
+    off (silent errors); the others are failures. Cuts, blank frames and the first frame are
+    not counted."""
+    csv_path = work / "registration.csv"
+    subprocess.run([str(stab), "--quiet", "--lookahead", "15", "--fixed-crop", "--csv",
+                    str(csv_path)] + extra + [str(clip_y4m), "-"],
+                   stdout=subprocess.DEVNULL, check=True)
+    with open(csv_path) as f:
+        rows = list(csv.DictReader(f))
+    g = [np.vstack([np.reshape(r, (2, 3)), [0, 0, 1]]) for r in truth["g"]]
+    skip = set(truth["cuts"]) | set(truth["blank"]) | {b + 1 for b in truth["blank"]}
+    corners = np.array([[0, 0, 1], [W - 1, 0, 1], [0, H - 1, 1], [W - 1, H - 1, 1]], float).T
+    errs, failed = [], 0
+    for k in range(1, min(len(rows), len(g))):
+        if k in skip or rows[k]["status"] in ("first", "cut"):
+            continue
+        if rows[k]["status"] not in ("ok", "still"):
+            failed += 1
+            continue
+        path = [camera(float(rows[j]["raw_tx"]), float(rows[j]["raw_ty"]),
+                       float(rows[j]["raw_angle"]), np.exp(float(rows[j]["raw_log_scale"])))
+                for j in (k - 1, k)]
+        got = path[1] @ np.linalg.inv(path[0])
+        want = g[k] @ np.linalg.inv(g[k - 1])
+        d = (got @ corners)[:2] - (want @ corners)[:2]
+        errs.append(float(np.sqrt((d ** 2).sum(0)).mean()))
+    e = np.array(errs)
+    return {"frames": len(errs) + failed, "ok": len(errs), "failed": failed,
+            "silent": int((e > 2.0).sum()), "mean": float(e.mean()) if len(e) else 0.0,
+            "p95": float(np.percentile(e, 95)) if len(e) else 0.0}
+
+
 def report(results, clips, meta):
     L = ["Per clip; every cell lists home-stab causal / home-stab --lookahead 15 / vidstab / "
          "deshake. jitter: px RMS against the truth (compare.py's); pc jitter: from phase "
@@ -691,6 +731,8 @@ def report(results, clips, meta):
          "|---|---|---|---|---|---|---|---|---|---|---|"]
     for clip in clips:
         r = results[clip.name]
+        if "input" not in r:
+            continue
         inp = r["input"]
         follow = cells(r, "drift" if r["static"] else "follow", "%.2f", "min")
         if any("zoom_err" in r.get(m, {}) for m in METHODS):
@@ -735,6 +777,27 @@ def report(results, clips, meta):
                         c.name, m, base[m]["jitter"], r[m]["jitter"],
                         r[m]["jitter"] - base[m]["jitter"],
                         r[m]["pc_jitter"] - base[m]["pc_jitter"]))
+    reg = [c for c in clips if "registration" in results[c.name]]
+    if reg:
+        L += ["", "Registration inside home-stab (--lookahead 15, its CSV's raw path) against the "
+              "truth, frame to frame: ok counts the frames reported ok or still; silent: of "
+              "those, more than 2 px off (mean corner error); failed: held frames (cuts and "
+              "blank frames not counted).", "",
+              "| clip | set | frames | failed % | silent % of ok | mean err px (ok) | p95 px |",
+              "|---|---|---|---|---|---|---|"]
+        for half in ("tuning", "test"):
+            rows = [(c, results[c.name]["registration"]) for c in reg if c.half == half]
+            for c, r in rows:
+                L.append("| %s | %s | %d | %.1f | %.1f | %.3f | %.2f |" % (
+                    c.name, half, r["frames"], 100.0 * r["failed"] / max(r["frames"], 1),
+                    100.0 * r["silent"] / max(r["ok"], 1), r["mean"], r["p95"]))
+            if rows:
+                n = sum(r["frames"] for _, r in rows)
+                ok = sum(r["ok"] for _, r in rows)
+                L.append("| **all %s** | %s | %d | %.1f | %.1f | %.3f | |" % (
+                    half, half, n, 100.0 * (n - ok) / max(n, 1),
+                    100.0 * sum(r["silent"] for _, r in rows) / max(ok, 1),
+                    sum(r["mean"] * r["ok"] for _, r in rows) / max(ok, 1)))
     L += ["", "Clips:", "", "| clip | set | scenario | what | source | frames |",
           "|---|---|---|---|---|---|"]
     for c in clips:
@@ -759,6 +822,8 @@ def main():
     ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--stab-args", default="", help="extra home-stab options")
     ap.add_argument("--jobs", type=int, default=2, help="processes measuring the outputs")
+    ap.add_argument("--registration-only", action="store_true",
+                    help="only home-stab's registrations against the truth (no methods)")
     args = ap.parse_args()
     build = REPO / args.build
     work = Path(args.out) if args.out else build / "bench-stab-realworld"
@@ -792,6 +857,11 @@ def main():
             y4m, truth = ctx.render(clip)
             n = y4m_frames(y4m)
             results[clip.name] = {"frames": n, "static": bool(truth and truth["static"])}
+            if truth:
+                results[clip.name]["registration"] = registration(
+                    stab, y4m, truth, ctx.clip_dir(clip), args.stab_args.split())
+            if args.registration_only:
+                continue
             pending.append((clip.name, "input", pool.submit(measure, y4m, None, truth)))
             for m in chosen:
                 out = work / "out" / ("%s_%s.y4m" % (clip.name, m.replace(" ", "_")))
