@@ -131,7 +131,11 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         vouches = trial.refine_zncc >= VOUCH_ZNCC &&
                   trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
         /* overruling HOME takes the whole frame: nearly every point consistent */
-        if (agrees && result->sigma_px <= trial.sigma_px) {
+        /* the wide radius only admits the refinement's move; a like-for-like choice by sigma
+         * needs the two within 3 sigma of each other (else the refinement went elsewhere: to
+         * moving objects the static test below can then refute, say) */
+        if (agrees && result->sigma_px <= trial.sigma_px &&
+            d <= 3.0 * (trial.sigma_px > result->sigma_px ? trial.sigma_px : result->sigma_px)) {
             /* consistent, and HOME's line fit predicts the smaller error: it stays */
             trial = *result;
             trial.refine_status = HOME_REFINE_LESS_PRECISE;

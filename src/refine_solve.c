@@ -12,6 +12,12 @@
 #define NOISE_CHECK_PX 0.5  /* (that prediction is made only for steps below this) */
 #define MAX_CORNER_STD_PX 0.5 /* worst corner's standard deviation (Fisher, or split-half) above
                                  this, or above max_sigma_px: ill conditioned */
+/* The template's gradients carry its noise: E[g g^T] = g_true g_true^T + var(g) I, so J^T W J
+ * holds information the noise only appears to give (a horizon in fog, the flat areas between
+ * a few edges: every direction looks constrained). var(g) of a 2x central difference is about
+ * the residual variance (two frames' noise) times this; taking each block's strongest
+ * gradient raises it above 1 (3: the tuning set's calibration, docs/trust.md) */
+#define NOISE_GRADIENT_SHARE 3.0
 #define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
                                   (calibrated on the evaluation's tuning set: neighbouring
                                   template points do not carry independent noise) */
@@ -257,6 +263,54 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     return 1;
 }
 
+/* Removes from s->jtj (the finest level's J^T W J) the part the template's gradient noise
+ * contributes on average: var(g) sum w D^T D, D the warp's 2x8 Jacobian at each point,
+ * D = [u v 1 0 0 0 -u^2 -uv; 0 0 0 u v 1 -uv -v^2]: its entries are the weighted moments
+ * m[a][b] = sum w u^a v^b up to degree 4. */
+static void remove_noise_information(home__refine_solver *s)
+{
+    const home__refine_points *tp = &s->tpl[s->finest];
+    const double sc = (double)(1 << s->finest), o = 0.5 * (sc - 1.0);
+    const double k = s->f / (2.0 * sc);
+    const double var_g = NOISE_GRADIENT_SHARE * s->resid_var * k * k;
+    double m[5][5], b[64];
+    int i, p, q;
+    memset(m, 0, sizeof m);
+    for (i = 0; i < tp->n; i++) {
+        const double w = s->wt[i], u = (tp->x[i] * sc + o - s->cx) / s->f,
+                     v = (tp->y[i] * sc + o - s->cy) / s->f;
+        double wu = w;
+        int a, c;
+        if (!(w > 0.0)) continue;
+        for (a = 0; a <= 4; a++, wu *= u) {
+            double wuv = wu;
+            for (c = 0; a + c <= 4; c++, wuv *= v) m[a][c] += wuv;
+        }
+    }
+    memset(b, 0, sizeof b);
+    b[0 * 8 + 0] = b[3 * 8 + 3] = m[2][0];
+    b[0 * 8 + 1] = b[3 * 8 + 4] = m[1][1];
+    b[0 * 8 + 2] = b[3 * 8 + 5] = m[1][0];
+    b[1 * 8 + 1] = b[4 * 8 + 4] = m[0][2];
+    b[1 * 8 + 2] = b[4 * 8 + 5] = m[0][1];
+    b[2 * 8 + 2] = b[5 * 8 + 5] = m[0][0];
+    b[0 * 8 + 6] = -m[3][0];
+    b[0 * 8 + 7] = b[1 * 8 + 6] = b[3 * 8 + 6] = -m[2][1];
+    b[1 * 8 + 7] = b[3 * 8 + 7] = b[4 * 8 + 6] = -m[1][2];
+    b[4 * 8 + 7] = -m[0][3];
+    b[2 * 8 + 6] = -m[2][0];
+    b[2 * 8 + 7] = b[5 * 8 + 6] = -m[1][1];
+    b[5 * 8 + 7] = -m[0][2];
+    b[6 * 8 + 6] = m[4][0] + m[2][2];
+    b[6 * 8 + 7] = m[3][1] + m[1][3];
+    b[7 * 8 + 7] = m[2][2] + m[0][4];
+    for (p = 0; p < 8; p++)
+        for (q = p; q < 8; q++) {
+            s->jtj[p * 8 + q] -= var_g * b[p * 8 + q];
+            s->jtj[q * 8 + p] = s->jtj[p * 8 + q];
+        }
+}
+
 /* Weighted residual variance of the last iteration (its weights and residuals are still in the
  * scratch), for the Fisher covariance below. */
 static double residual_variance(const home__refine_solver *s)
@@ -463,8 +517,11 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
     s->alpha = 1.0;
     s->hessian_level = -1;
     s->k = 8;
-    for (s->finest = st->finest_level; s->finest < st->levels - 1; s->finest++)
-        if (s->tpl[s->finest].n >= FINEST_MIN_POINTS) break;
+    for (s->finest = st->finest_level; s->finest < st->levels - 1; s->finest++) {
+        const int cap_half = s->tpl[s->finest].capacity / 2;
+        if (s->tpl[s->finest].n >= (cap_half < FINEST_MIN_POINTS ? cap_half : FINEST_MIN_POINTS))
+            break;
+    }
 }
 
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid.
@@ -521,6 +578,7 @@ void home__refine_run(home_context *ctx, int slot, const double *h0, home_result
     if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return; }
     to_pixels(&s, s.hn, h1);
     s.resid_var = residual_variance(&s);
+    remove_noise_information(&s);
     refined_std = corner_std_px(&s);
     if (refined_std > max_std || !(s.split_px <= max_std)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
