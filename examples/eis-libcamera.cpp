@@ -7,10 +7,14 @@
 // main thread through a queue, stabilised there with libhome, written as Y4M (I420) and reused.
 // A frame byte-identical to the one before (a source repeating frames: libcamera's virtual
 // camera shows each image 4 times) is not registered again: it is written as a copy of that
-// frame's stabilised output. A clean stop cancels and frees all.
+// frame's stabilised output. A clean stop cancels and frees all. With --threads N > 1 (default:
+// the online CPUs up to 4) the warp of each due frame runs in row bands on a fixed pool of N - 1
+// workers (eis_pool.h), whose last band's worker writes it out, while the main thread registers
+// the next frame: the same bytes as one thread.
 // Builds against Debian 12's libcamera 0.0.3 and libcamera 0.4 to 0.7 (Raspberry Pi OS).
 // Exit: 0 done, 2 usage/setup error, 3 camera lost or failed while streaming, 4 no camera.
 #include "eis_common.h"
+#include "eis_pool.h"
 #include "home_stab.h"
 
 #include <libcamera/libcamera.h>
@@ -25,6 +29,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -45,6 +50,7 @@ struct Options {
     long frames = 0;
     float margin_x = 0.10f, margin_y = 0.10f, smoothing = 0.0f;   // 0: automatic (home_stab_config)
     int lookahead = EIS_LIVE_LOOKAHEAD;
+    int threads = 0;   // 0: eis_pool_auto_threads()
     bool quiet = false, keep_repeats = false;
 };
 
@@ -52,15 +58,18 @@ void usage(FILE *f)
 {
     std::fprintf(f, "usage: eis-libcamera [--camera ID|INDEX] [--size WxH] [--format yu12|nv12|yuyv]\n"
                     "       [--frames N] [--margin F] [--margin-x F] [--margin-y F] [--smoothing F]\n"
-                    "       [--lookahead N] [--output FILE.y4m|-] [--raw-output FILE.y4m] [--keep-repeats]\n"
-                    "       [--quiet] [--list]\n"
+                    "       [--lookahead N] [--threads N] [--output FILE.y4m|-] [--raw-output FILE.y4m]\n"
+                    "       [--keep-repeats] [--quiet] [--list]\n"
                     "  --frames N        stop after N captured frames (default: until interrupted)\n"
                     "  --output F        the stabilised frames as Y4M (I420); --raw-output F: as captured\n"
                     "  --keep-repeats    register a frame identical to the one before as any other (by\n"
                     "                    default it is written as a copy of that frame's stabilised output)\n"
+                    "  --threads N       1: register, warp and write in turn; N > 1: the warp in bands on\n"
+                    "                    N - 1 more threads while the next frame registers (same bytes);\n"
+                    "                    0 (default): the online CPUs, at most %d (here %d)\n"
                     "Buffers come from the camera's FrameBufferAllocator or, where that fails, from\n"
                     "memfd application memory. Exit: 0 done, 2 usage/setup error, 3 camera lost or\n"
-                    "failed, 4 no camera.\n");
+                    "failed, 4 no camera.\n", EIS_POOL_AUTO_MAX, eis_pool_auto_threads());
 }
 
 int stab_format(const PixelFormat &f)
@@ -179,6 +188,7 @@ int main(int argc, char **argv)
         else if (a == "--margin-x") { o.margin_x = std::strtof(v, &end); bad = *end; }
         else if (a == "--margin-y") { o.margin_y = std::strtof(v, &end); bad = *end; }
         else if (a == "--smoothing") { o.smoothing = std::strtof(v, &end); bad = *end; }
+        else if (a == "--threads") { o.threads = (int)std::strtol(v, &end, 10); bad = *end || o.threads < 0 || o.threads > EIS_POOL_MAX_THREADS; }
         else if (a == "--lookahead") { o.lookahead = (int)std::strtol(v, &end, 10); bad = *end || o.lookahead < 0 || o.lookahead > HOME_STAB_MAX_LOOKAHEAD; }
         else { std::fprintf(stderr, "eis-libcamera: unknown option %s (see --help)\n", a.c_str()); return 2; }
         if (bad) { std::fprintf(stderr, "eis-libcamera: bad value for %s: %s\n", a.c_str(), v); return 2; }
@@ -237,7 +247,9 @@ int main(int argc, char **argv)
     void *arena = nullptr;
     std::vector<std::vector<uint8_t>> ring;
     std::vector<int> repeats;   // per ring slot: captured repeats of that frame not yet written
-    std::vector<uint8_t> warped, i420;
+    std::vector<int> copies;    // per ring slot: outputs the output job writes of its frame
+    std::vector<uint8_t> warped, i420, job_i420;   // i420: this thread's; job_i420: the output job's
+    eis_pool *pool = nullptr;
     FILE *out = nullptr, *raw_out = nullptr;
     Stream *stream = nullptr;
     int format = 0;
@@ -245,26 +257,35 @@ int main(int argc, char **argv)
     long captured = 0, pushed = 0, repeated = 0, written = 0, failed_frames = 0;
     long shown = -1;   // the newest frame (push index) whose stabilised output was written
 
-    auto write_i420 = [&](FILE *f, const uint8_t *frame) -> bool {
-        eis_to_i420(format, (int)width, (int)height, frame, i420.data(), 0, 0);
-        if (std::fputs("FRAME\n", f) < 0 || std::fwrite(i420.data(), 1, i420.size(), f) != i420.size()) {
+    auto write_i420 = [&](FILE *f, const uint8_t *frame, std::vector<uint8_t> &buf) -> bool {
+        eis_to_i420(format, (int)width, (int)height, frame, buf.data(), 0, 0);
+        if (std::fputs("FRAME\n", f) < 0 || std::fwrite(buf.data(), 1, buf.size(), f) != buf.size()) {
             std::fprintf(stderr, "eis-libcamera: write error\n");
             return false;
         }
         return true;
     };
-    // warp the frame due and write it, once and once more per repeat of it captured so far
+    // the output job, once frame `frame` is warped (on a pool worker, or here with one thread)
+    std::function<int(long)> output_job = [&](long frame) -> int {
+        for (int c = copies[(size_t)frame % ring.size()]; out && c > 0; c--, written++)
+            if (!write_i420(out, warped.data(), job_i420)) return 1;
+        return 0;
+    };
+    const eis_pool_done_fn run_output_job = [](void *user, long frame, double) -> int {
+        return (*static_cast<std::function<int(long)> *>(user))(frame);
+    };
+    // warp the frame due and write it, once and once more per repeat of it captured so far,
+    // after the previous one (it shares `warped` and the counters)
     auto show = [&](const home_stab_output &so) -> bool {
         home_stab_image src, dst;
         const size_t slot = (size_t)so.frame % ring.size();
+        if (eis_pool_wait(pool) != HOME_OK) return false;
         eis_frame_view(format, (int)width, (int)height, ring[slot].data(), &src);
         eis_frame_view(format, (int)width, (int)height, warped.data(), &dst);
-        if (home_stab_warp(so.warp, &src, &dst) != HOME_OK) return false;
-        shown = so.frame;
-        for (int copies = 1 + repeats[slot]; out && copies > 0; copies--, written++)
-            if (!write_i420(out, warped.data())) return false;
+        copies[slot] = 1 + repeats[slot];
         repeats[slot] = 0;
-        return true;
+        shown = so.frame;
+        return eis_pool_submit(pool, so.warp, &src, &dst, run_output_job, &output_job, so.frame) == HOME_OK;
     };
 
     do {
@@ -309,11 +330,20 @@ int main(int argc, char **argv)
             rc = 2;
             break;
         }
+        if (eis_pool_start(&pool, o.threads)) { std::fprintf(stderr, "eis-libcamera: cannot start %d threads\n", o.threads); rc = 2; break; }
+        if (!o.quiet) std::fprintf(stderr, "eis-libcamera: %d thread(s)\n", eis_pool_threads(pool));
         const size_t fbytes = eis_frame_bytes(format, (int)width, (int)height);
-        ring.assign((size_t)cfg.lookahead + 1, std::vector<uint8_t>(fbytes));
+        // the stabiliser reports frame n - lookahead: keep them; with workers, frame n + 1 is
+        // captured while frame n - lookahead is warped; and a new frame is compared with the
+        // newest pushed before it replaces it (causal on one thread: a ring of 1 compared the
+        // frame with itself, and every frame after the first was taken as a repeat)
+        ring.assign((size_t)cfg.lookahead + 1 + (eis_pool_threads(pool) > 1 || cfg.lookahead == 0),
+                    std::vector<uint8_t>(fbytes));
         repeats.assign(ring.size(), 0);
+        copies.assign(ring.size(), 0);
         warped.resize(fbytes);
         i420.resize((size_t)width * height * 3 / 2);
+        job_i420.resize(i420.size());
         if (!o.output.empty()) {
             out = o.output == "-" ? stdout : std::fopen(o.output.c_str(), "wb");
             if (!out) { std::fprintf(stderr, "eis-libcamera: cannot write %s\n", o.output.c_str()); rc = 2; break; }
@@ -409,14 +439,14 @@ int main(int argc, char **argv)
                     }
                 }
                 if (ok) captured++;
-                if (ok && raw_out && !write_i420(raw_out, slot)) rc = 2;
+                if (ok && raw_out && !write_i420(raw_out, slot, i420)) rc = 2;
                 if (ok && !rc && !o.keep_repeats && pushed > 0 &&
                     std::memcmp(slot, ring[(size_t)(pushed - 1) % ring.size()].data(), fbytes) == 0) {
                     // a repeat of the newest frame: written again if its output already was,
                     // else with it
                     repeated++;
-                    if (shown == pushed - 1) {
-                        if (out && !write_i420(out, warped.data())) rc = 2;
+                    if (shown == pushed - 1) {   // once its output job is done
+                        if (eis_pool_wait(pool) != HOME_OK || (out && !write_i420(out, warped.data(), i420))) rc = 2;
                         written += out ? 1 : 0;
                     } else {
                         repeats[(size_t)(pushed - 1) % ring.size()]++;
@@ -449,6 +479,8 @@ int main(int argc, char **argv)
         while (rc != 2 && home_stab_flush(stab, &so) == HOME_OK && so.ready)
             if (!show(so)) { rc = 2; break; }
     } while (false);
+    if (pool && eis_pool_wait(pool) != HOME_OK) rc = 2;   // the last frame out
+    eis_pool_stop(pool);
 
     if (started) camera->stop();           // completes every pending request as cancelled
     if (started) camera->requestCompleted.disconnect(&completed, &CompletionQueue::push);

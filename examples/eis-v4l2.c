@@ -4,12 +4,19 @@
  * clean exit). Frames are stabilised with libhome and shown side by side (original | stabilised)
  * in an SDL2 window when built with SDL2, and/or written as Y4M (I420) to a file or stdout.
  * fps and per-stage milliseconds go to stderr once a second.
+ * Threads (--threads N, default: the online CPUs up to 4): the capture thread dequeues, copies
+ * and registers; the warp of each due frame runs on a fixed pool of N - 1 workers in row bands
+ * (examples/eis_pool.h), overlapping the next registration, and the worker that ends it writes
+ * the frame out. The output is byte-identical for any N. The window is drawn by the capture
+ * thread (SDL's), a frame later with N > 1.
  * Exit: 0 done (frame count reached or interrupted), 1 device stalled (select timeout),
  * 2 usage / setup error, 3 device lost while streaming. */
 #define _DEFAULT_SOURCE
 #include "eis_common.h"
+#include "eis_pool.h"
 #include "home_stab.h"
 #include <errno.h>
+#include <pthread.h>
 #include <fcntl.h>
 #include <linux/videodev2.h>
 #include <signal.h>
@@ -55,7 +62,7 @@ typedef struct camera {
 
 typedef struct options {
     const char *device, *output;
-    int width, height, frames, buffers, timeout_ms, window, quiet;
+    int width, height, frames, buffers, timeout_ms, window, quiet, threads;
     uint32_t fourcc;
     float margin, smoothing;
     int lookahead;
@@ -65,14 +72,17 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: eis-v4l2 [--device /dev/videoN] [--size WxH] [--format yuyv|nv12|yu12]\n"
                "       [--frames N] [--buffers N] [--timeout-ms N] [--margin F] [--smoothing F]\n"
-               "       [--lookahead N] [--output FILE.y4m|-] [--no-window] [--quiet]\n"
+               "       [--lookahead N] [--threads N] [--output FILE.y4m|-] [--no-window] [--quiet]\n"
+               "  --threads N   1: capture, register, warp and write in turn; N > 1: the warp in bands\n"
+               "                on N - 1 more threads while the next frame registers (same bytes);\n"
+               "                0 (default): the online CPUs, at most %d (here %d)\n"
                "Exit: 0 done, 1 device stalled (select timeout), 2 usage/setup error, 3 device lost.\n"
 #ifdef HAVE_SDL2
                "Window: SDL2, original | stabilised (close it or press q to stop).\n"
 #else
                "Window: not built (SDL2 was missing); use --output.\n"
 #endif
-    );
+    , EIS_POOL_AUTO_MAX, eis_pool_auto_threads());
 }
 
 static int parse(int argc, char **argv, options *o)
@@ -105,6 +115,7 @@ static int parse(int argc, char **argv, options *o)
         } else if (!strcmp(a, "--frames")) { o->frames = (int)strtol(v, &end, 10); if (*end || o->frames < 0) goto bad; }
         else if (!strcmp(a, "--buffers")) { o->buffers = (int)strtol(v, &end, 10); if (*end || o->buffers < 2 || o->buffers > MAX_BUFFERS) goto bad; }
         else if (!strcmp(a, "--timeout-ms")) { o->timeout_ms = (int)strtol(v, &end, 10); if (*end || o->timeout_ms < 1) goto bad; }
+        else if (!strcmp(a, "--threads")) { o->threads = (int)strtol(v, &end, 10); if (*end || o->threads < 0 || o->threads > EIS_POOL_MAX_THREADS) goto bad; }
         else if (!strcmp(a, "--lookahead")) { o->lookahead = (int)strtol(v, &end, 10); if (*end || o->lookahead < 0 || o->lookahead > HOME_STAB_MAX_LOOKAHEAD) goto bad; }
         else if (!strcmp(a, "--margin")) { o->margin = strtof(v, &end); if (*end) goto bad; }
         else if (!strcmp(a, "--smoothing")) { o->smoothing = strtof(v, &end); if (*end) goto bad; }
@@ -309,45 +320,64 @@ static int copy_frame(const camera *c, const struct v4l2_buffer *buf, const stru
 }
 
 
-typedef struct stage_clock { double wait, copy, reg, warp, out; long frames, skipped; double since; } stage_clock;
+/* Per-stage milliseconds of the capture thread since the last report. */
+typedef struct stage_clock { double wait, copy, reg, blocked; long frames; double since; } stage_clock;
+
+/* What the output job adds up (a pool worker's with --threads > 1): under the sink's lock. */
+typedef struct out_clock { double warp, out, latency, latency_max; long frames; } out_clock;
 
 /* Where stabilised frames go: the Y4M file and/or the window. */
 typedef struct sink {
     int format, width, height, ring_len;
-    uint8_t **ring, *warped, *shown;
+    uint8_t **ring, *warped[2], *i420, *shown;   /* warped: by frame parity (the window's frame
+                                                    stays while the next is warped) */
+    double *captured_at;          /* per ring slot: when its frame was dequeued (ms) */
     FILE *out;
+    eis_pool *pool;
+    long pending;                 /* the window: the frame submitted and not yet shown, or -1 */
+    pthread_mutex_t lock;         /* guards the rest */
     long written;
+    out_clock now, total;         /* since the last report; since the start */
 #ifdef HAVE_SDL2
     SDL_Renderer *ren;
     SDL_Texture *tex;
 #endif
 } sink;
 
-/* Warp the due frame and send it on; -1 when output failed or the window was closed. */
-static int show(sink *k, const home_stab_output *so, stage_clock *st)
+/* The output job, once frame `frame` is warped (on a pool worker, or here with one thread): the
+ * Y4M frame, and the frame's time from capture to output. */
+static int write_out(void *user, long frame, double warp_ms)
 {
+    sink *k = user;
     const size_t i420 = (size_t)k->width * k->height * 3 / 2;
-    const uint8_t *orig = k->ring[so->frame % k->ring_len];
-    home_stab_image src, dst;
-    double t0 = eis_now_ms(NULL), t1;
-    eis_frame_view(k->format, k->width, k->height, (uint8_t *)orig, &src);
-    eis_frame_view(k->format, k->width, k->height, k->warped, &dst);
-    if (home_stab_warp(so->warp, &src, &dst) != HOME_OK) return -1;
-    t1 = eis_now_ms(NULL);
-    st->warp += t1 - t0;
+    const double t0 = eis_now_ms(NULL);
+    double t1, latency;
+    int bad = 0;
     if (k->out) {
-        eis_to_i420(k->format, k->width, k->height, k->warped, k->shown, 0, 0);
-        if (fputs("FRAME\n", k->out) < 0 || fwrite(k->shown, 1, i420, k->out) != i420) {
-            fprintf(stderr, "eis-v4l2: write error\n");
-            return -1;
-        }
-        k->written++;
+        eis_to_i420(k->format, k->width, k->height, k->warped[frame % 2], k->i420, 0, 0);
+        bad = fputs("FRAME\n", k->out) < 0 || fwrite(k->i420, 1, i420, k->out) != i420;
+        if (bad) fprintf(stderr, "eis-v4l2: write error\n");
     }
+    t1 = eis_now_ms(NULL);
+    latency = t1 - k->captured_at[frame % k->ring_len];
+    pthread_mutex_lock(&k->lock);
+    k->written += k->out && !bad;
+    k->now.warp += warp_ms; k->now.out += t1 - t0; k->now.latency += latency; k->now.frames++;
+    if (latency > k->now.latency_max) k->now.latency_max = latency;
+    k->total.warp += warp_ms; k->total.out += t1 - t0; k->total.latency += latency; k->total.frames++;
+    if (latency > k->total.latency_max) k->total.latency_max = latency;
+    pthread_mutex_unlock(&k->lock);
+    return bad;
+}
+
+/* Draw the pending frame in the window, original | stabilised (this thread created it). */
+static void present(sink *k)
+{
 #ifdef HAVE_SDL2
-    if (k->tex) {
+    if (k->tex && k->pending >= 0) {
         SDL_Event ev;
-        eis_to_i420(k->format, k->width, k->height, orig, k->shown, 1, 0);
-        eis_to_i420(k->format, k->width, k->height, k->warped, k->shown, 1, 1);
+        eis_to_i420(k->format, k->width, k->height, k->ring[k->pending % k->ring_len], k->shown, 1, 0);
+        eis_to_i420(k->format, k->width, k->height, k->warped[k->pending % 2], k->shown, 1, 1);
         SDL_UpdateTexture(k->tex, NULL, k->shown, 2 * k->width);
         SDL_RenderClear(k->ren);
         SDL_RenderCopy(k->ren, k->tex, NULL, NULL);
@@ -356,7 +386,27 @@ static int show(sink *k, const home_stab_output *so, stage_clock *st)
             if (ev.type == SDL_QUIT || (ev.type == SDL_KEYDOWN && ev.key.keysym.sym == SDLK_q)) stop_requested = 1;
     }
 #endif
-    st->out += eis_now_ms(NULL) - t1;
+    k->pending = -1;
+}
+
+/* Hand the due frame to the output job, once the previous one is written (and drawn): -1 when
+ * the warp or the output failed, or the window was closed. */
+static int show(sink *k, const home_stab_output *so, stage_clock *st)
+{
+    home_stab_image src, dst;
+    const double t0 = eis_now_ms(NULL);
+    int status = eis_pool_wait(k->pool);
+    st->blocked += eis_now_ms(NULL) - t0;
+    if (status != HOME_OK) return -1;
+    present(k);
+    eis_frame_view(k->format, k->width, k->height, k->ring[so->frame % k->ring_len], &src);
+    eis_frame_view(k->format, k->width, k->height, k->warped[so->frame % 2], &dst);
+    if (eis_pool_submit(k->pool, so->warp, &src, &dst, write_out, k, so->frame) != HOME_OK) return -1;
+    k->pending = so->frame;
+    if (eis_pool_threads(k->pool) == 1) {   /* done already: draw it now */
+        if (eis_pool_wait(k->pool) != HOME_OK) return -1;
+        present(k);
+    }
     return 0;
 }
 
@@ -371,7 +421,8 @@ int main(int argc, char **argv)
     sink k;
     stage_clock st;
     long pushed = 0, eintr_seen = 0, skipped = 0;
-    int rc = 0, i, status;
+    double t_first = 0;
+    int rc = 0, i, status, threads;
     size_t fbytes, need;
     struct sigaction sa;
     char name[5];
@@ -407,17 +458,29 @@ int main(int argc, char **argv)
     k.format = stab_format(cam.fourcc);
     k.width = cam.width;
     k.height = cam.height;
+    k.pending = -1;
+    if (eis_pool_start(&k.pool, o.threads) || pthread_mutex_init(&k.lock, NULL)) {
+        fprintf(stderr, "eis-v4l2: cannot start %d threads\n", o.threads);
+        camera_close(&cam);
+        return 2;
+    }
     fbytes = eis_frame_bytes(k.format, cam.width, cam.height);
-    k.ring_len = cfg.lookahead + 1;   /* the stabiliser reports frame n - lookahead: keep them */
+    /* the stabiliser reports frame n - lookahead: keep them; with workers, frame n + 1 is
+     * captured while frame n - lookahead is warped */
+    k.ring_len = cfg.lookahead + 1 + (eis_pool_threads(k.pool) > 1);
     k.ring = calloc((size_t)k.ring_len, sizeof *k.ring);
-    k.warped = malloc(fbytes);
-    k.shown = malloc((size_t)cam.width * cam.height * 3);   /* I420, up to 2w x h */
+    k.captured_at = calloc((size_t)k.ring_len, sizeof *k.captured_at);
+    k.warped[0] = malloc(fbytes);
+    k.warped[1] = malloc(fbytes);
+    k.i420 = malloc((size_t)cam.width * cam.height * 3 / 2);
+    k.shown = malloc((size_t)cam.width * cam.height * 3);   /* I420, 2w x h */
     for (i = 0; k.ring && i < k.ring_len; i++) k.ring[i] = malloc(fbytes);
-    if (!k.ring || !k.warped || !k.shown || !k.ring[k.ring_len - 1]) {
+    if (!k.ring || !k.captured_at || !k.warped[0] || !k.warped[1] || !k.i420 || !k.shown || !k.ring[k.ring_len - 1]) {
         fprintf(stderr, "eis-v4l2: out of memory\n");
         camera_close(&cam);
         return 2;
     }
+    if (!o.quiet) fprintf(stderr, "eis-v4l2: %d thread(s)\n", eis_pool_threads(k.pool));
     if (o.output) {
         k.out = strcmp(o.output, "-") ? fopen(o.output, "wb") : stdout;
         if (!k.out) { fprintf(stderr, "eis-v4l2: cannot write %s\n", o.output); camera_close(&cam); return 2; }
@@ -482,6 +545,8 @@ int main(int argc, char **argv)
         }
         t1 = eis_now_ms(NULL);
         st.wait += t1 - t0;
+        if (!t_first) t_first = t1;
+        k.captured_at[pushed % k.ring_len] = t1;
         slot = k.ring[pushed % k.ring_len];
         bad = (buf.flags & V4L2_BUF_FLAG_ERROR) || copy_frame(&cam, &buf, planes, slot);
         if (queue_buffer(&cam, buf.index)) {
@@ -500,9 +565,17 @@ int main(int argc, char **argv)
         st.reg += so.ms_register;
         if (so.ready && show(&k, &so, &st)) { rc = 2; break; }
         if (!o.quiet && eis_now_ms(NULL) - st.since >= 1000.0) {
-            double dt = eis_now_ms(NULL) - st.since, n = st.frames ? (double)st.frames : 1.0;
-            fprintf(stderr, "eis-v4l2: %.1f fps | ms/frame: wait %.1f copy %.1f register %.1f warp %.1f output %.1f | %ld skipped\n",
-                    st.frames * 1e3 / dt, st.wait / n, st.copy / n, st.reg / n, st.warp / n, st.out / n, skipped);
+            double dt = eis_now_ms(NULL) - st.since, n = st.frames ? (double)st.frames : 1.0, m;
+            out_clock oc;
+            pthread_mutex_lock(&k.lock);
+            oc = k.now;
+            memset(&k.now, 0, sizeof k.now);
+            pthread_mutex_unlock(&k.lock);
+            m = oc.frames ? (double)oc.frames : 1.0;
+            fprintf(stderr, "eis-v4l2: %.1f fps | ms/frame: wait %.1f copy %.1f register %.1f blocked %.1f warp %.1f "
+                            "output %.1f | capture to output %.1f ms (max %.1f) | %ld skipped\n",
+                    st.frames * 1e3 / dt, st.wait / n, st.copy / n, st.reg / n, st.blocked / n, oc.warp / m,
+                    oc.out / m, oc.latency / m, oc.latency_max, skipped);
             memset(&st, 0, sizeof st);
             st.since = eis_now_ms(NULL);
         }
@@ -510,10 +583,21 @@ int main(int argc, char **argv)
     /* the frames still queued for lookahead are shown too, whatever ended the stream */
     while (rc != 2 && home_stab_flush(stab, &so) == HOME_OK && so.ready)
         if (show(&k, &so, &st)) { rc = 2; break; }
-    if (!o.quiet)
+    if (eis_pool_wait(k.pool) != HOME_OK) rc = 2;   /* the last frame out */
+    present(&k);
+    threads = eis_pool_threads(k.pool);
+    eis_pool_stop(k.pool);                           /* the workers end: k is this thread's */
+    if (!o.quiet) {
+        const double n = k.total.frames ? (double)k.total.frames : 1.0, dt = eis_now_ms(NULL) - t_first;
         fprintf(stderr, "eis-v4l2: %ld frames stabilised, %ld written, %ld skipped (error flag, short buffer or EIO), "
                         "%ld interrupted waits retried%s\n",
                 pushed, k.written, skipped, eintr_seen, stop_requested ? ", stopped by signal or window" : "");
+        if (k.total.frames)
+            fprintf(stderr, "eis-v4l2: %d thread(s): %.1f frames/s from the first capture to the last output; "
+                            "per frame: warp %.2f ms, output %.2f ms, capture to output %.2f ms (max %.2f)\n",
+                    threads, k.total.frames * 1e3 / dt, k.total.warp / n, k.total.out / n,
+                    k.total.latency / n, k.total.latency_max);
+    }
     camera_close(&cam);
     if (k.out && fflush(k.out) != 0) rc = 2;
     if (k.out && k.out != stdout) fclose(k.out);
@@ -524,6 +608,7 @@ int main(int argc, char **argv)
     SDL_Quit();
 #endif
     for (i = 0; i < k.ring_len; i++) free(k.ring[i]);
-    free(k.ring); free(k.warped); free(k.shown); free(arena);
+    free(k.ring); free(k.captured_at); free(k.warped[0]); free(k.warped[1]); free(k.i420); free(k.shown); free(arena);
+    pthread_mutex_destroy(&k.lock);
     return rc;
 }

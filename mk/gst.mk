@@ -21,7 +21,7 @@ GST_PLUGINDIR ?= $(shell $(PKG_CONFIG) --variable=pluginsdir gstreamer-1.0 2> /d
 # GStreamer's and GLib's headers are not -pedantic clean: included as system headers
 GST_CFLAGS = $(patsubst -I%,-isystem %,$(shell $(PKG_CONFIG) --cflags $(GST_PKGS) $(if $(GST_HAVE_CHECK),gstreamer-check-1.0)))
 GST_LIBS = $(shell $(PKG_CONFIG) --libs $(GST_PKGS))
-CFLAGS_GST = -std=gnu99 $(OPT) -g $(WARN) -Iinclude $(ARCH_FLAGS) $(GST_CFLAGS)
+CFLAGS_GST = -std=gnu99 $(OPT) -g $(WARN) -Iinclude -Iexamples $(ARCH_FLAGS) $(GST_CFLAGS)
 .PHONY: install-gst gst-force
 
 GST_SKIPPED :=
@@ -57,9 +57,14 @@ $(BUILD)/obj/gst/%.o: examples/gst/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_GST) -fPIC $(CFLAGS) $(DEPFLAGS) -c $< -o $@
 
-$(GST_PLUGIN): $(BUILD)/obj/gst/gsthomestab.o $(GST_PIC_LIB)
+# the warp's worker pool, shared with the live examples
+$(BUILD)/obj/gst/eis_pool.o: examples/eis_pool.c
 	@mkdir -p $(dir $@)
-	$(CC) -shared -Wl,--no-undefined -Wl,-z,defs $^ -o $@ $(LDFLAGS) $(GST_LIBS) -lm
+	$(CC) $(CFLAGS_GST) -fPIC $(CFLAGS) $(DEPFLAGS) -c $< -o $@
+
+$(GST_PLUGIN): $(BUILD)/obj/gst/gsthomestab.o $(BUILD)/obj/gst/eis_pool.o $(GST_PIC_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) -shared -Wl,--no-undefined -Wl,-z,defs $^ -o $@ $(LDFLAGS) $(GST_LIBS) -lm -pthread
 
 # the element compiled in (registered as a static plugin), sanitized with the rest of the tests
 $(BUILD)/obj/gst-static/gsthomestab.o: examples/gst/gsthomestab.c
@@ -70,9 +75,13 @@ $(BUILD)/obj/gst-static/test_gst.o: tests/test_gst.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_GST) -Itests/support $(SAN) $(CFLAGS) $(DEPFLAGS) -c $< -o $@
 
-$(GST_TESTS): $(BUILD)/obj/gst-static/test_gst.o $(BUILD)/obj/gst-static/gsthomestab.o $(RUNNER_OBJ) $(LIB)
+$(BUILD)/obj/gst-static/eis_pool.o: examples/eis_pool.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) $(GST_LIBS) $(shell $(PKG_CONFIG) --libs gstreamer-check-1.0)
+	$(CC) $(CFLAGS_GST) $(SAN) $(CFLAGS) $(DEPFLAGS) -c $< -o $@
+
+$(GST_TESTS): $(BUILD)/obj/gst-static/test_gst.o $(BUILD)/obj/gst-static/gsthomestab.o $(BUILD)/obj/gst-static/eis_pool.o $(RUNNER_OBJ) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) $(GST_LIBS) $(shell $(PKG_CONFIG) --libs gstreamer-check-1.0) -pthread
 
 install-gst: $(GST_PLUGIN)
 	@if [ -z "$(GST_PLUGINDIR)" ]; then echo "install-gst: no GStreamer plugin directory (pkg-config --variable=pluginsdir gstreamer-1.0)"; exit 1; fi

@@ -17,11 +17,11 @@ $(LCV)/VERSION: libcamera-virtual-force
 libcamera-virtual-force:
 
 # pkg-config is asked in the recipe: the prefix exists only once the rule above ran
-$(LCV_EIS): examples/eis-libcamera.cpp examples/eis_common.h $(BUILD)/obj/examples/eis_common.o include/home_stab.h include/home.h $(LIB) $(LCV)/VERSION
+$(LCV_EIS): examples/eis-libcamera.cpp examples/eis_common.h examples/eis_pool.h $(BUILD)/obj/examples/eis_common.o $(BUILD)/obj/examples/eis_pool.o include/home_stab.h include/home.h $(LIB) $(LCV)/VERSION
 	@mkdir -p $(dir $@)
 	export PKG_CONFIG_PATH=$(abspath $(LCV))/prefix/lib/pkgconfig; \
 	$(CXX) -std=c++17 $(OPT) -g -Wall -Wextra -Werror -Iinclude $(ARCH_FLAGS) -Iexamples \
-		$$($(PKG_CONFIG) --cflags libcamera) $< $(BUILD)/obj/examples/eis_common.o $(LIB) -o $@ $(LDFLAGS_APP) \
+		$$($(PKG_CONFIG) --cflags libcamera) $< $(BUILD)/obj/examples/eis_common.o $(BUILD)/obj/examples/eis_pool.o $(LIB) -o $@ $(LDFLAGS_APP) \
 		$$($(PKG_CONFIG) --libs libcamera) -Wl,-rpath,$(abspath $(LCV))/prefix/lib -pthread
 
 # The rpicam-apps post-processing stage home_eis (examples/rpicam/, docs/libcamera.md): built by

@@ -73,11 +73,11 @@ $(BUILD)/obj/examples/eis-v4l2.o: examples/eis-v4l2.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $(DEPFLAGS) $(if $(filter 1,$(STAB_HAVE_SDL2)),-DHAVE_SDL2 $(shell $(PKG_CONFIG) --cflags sdl2)) -c $< -o $@
 
-$(BUILD)/bin/eis-v4l2: $(BUILD)/obj/examples/eis-v4l2.o $(BUILD)/obj/examples/eis_common.o $(LIB)
+$(BUILD)/bin/eis-v4l2: $(BUILD)/obj/examples/eis-v4l2.o $(BUILD)/obj/examples/eis_common.o $(BUILD)/obj/examples/eis_pool.o $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) $(if $(filter 1,$(STAB_HAVE_SDL2)),$(shell $(PKG_CONFIG) --libs sdl2))
+	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP) $(if $(filter 1,$(STAB_HAVE_SDL2)),$(shell $(PKG_CONFIG) --libs sdl2)) -pthread
 
-$(BUILD)/bin/eis-libcamera: examples/eis-libcamera.cpp examples/eis_common.h $(BUILD)/obj/examples/eis_common.o include/home_stab.h include/home.h $(LIB)
+$(BUILD)/bin/eis-libcamera: examples/eis-libcamera.cpp examples/eis_common.h examples/eis_pool.h $(BUILD)/obj/examples/eis_common.o $(BUILD)/obj/examples/eis_pool.o include/home_stab.h include/home.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++17 $(OPT) -g -Wall -Wextra -Werror -Iinclude $(ARCH_FLAGS) $(if $(SANITIZE),-fsanitize=$(SANITIZE) -fno-omit-frame-pointer) \
-		-Iexamples $(shell $(PKG_CONFIG) --cflags libcamera) $< $(BUILD)/obj/examples/eis_common.o $(LIB) -o $@ $(LDFLAGS_APP) $(shell $(PKG_CONFIG) --libs libcamera) -pthread
+		-Iexamples $(shell $(PKG_CONFIG) --cflags libcamera) $< $(BUILD)/obj/examples/eis_common.o $(BUILD)/obj/examples/eis_pool.o $(LIB) -o $@ $(LDFLAGS_APP) $(shell $(PKG_CONFIG) --libs libcamera) -pthread

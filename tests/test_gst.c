@@ -1,7 +1,8 @@
 /* GstHarness tests of the homestab element (examples/gst/gsthomestab.c, compiled in and
  * registered as a static plugin): frames out = frames in, the latency it reports, flushes,
  * renegotiation, refused caps, timestamps, the four formats against each other, statistics
- * messages, settings changed while streaming, frames from a small upstream pool. One line per test, then "N passed, N failed".
+ * messages, settings changed while streaming, frames from a small upstream pool, the warp on
+ * several threads. One line per test, then "N passed, N failed".
  * Headless: no plugins but GStreamer's core and this one are loaded. */
 #include <gst/gst.h>
 #include <gst/check/gstharness.h>
@@ -516,11 +517,58 @@ void test_gst_pooled_input_copied(void)
     gst_caps_unref(caps);
 }
 
+/* The shaky clip through the element with `threads` threads, switched to `later` threads after
+ * the first half (the pool restarts at the next warp); n frames out. */
+static int run_clip_threads(const char *format, int threads, int later, int n, GstBuffer **bufs)
+{
+    GstHarness *hh = harness(format, W, H);
+    int got;
+    g_object_set(hh->element, "lookahead", 4, "threads", threads, NULL);
+    CHECK_EQ_INT(push_frames(hh, format, W, H, 0, n / 2), GST_FLOW_OK);
+    g_object_set(hh->element, "threads", later, NULL);
+    CHECK_EQ_INT(push_frames(hh, format, W, H, n / 2, n - n / 2), GST_FLOW_OK);
+    CHECK(gst_harness_push_event(hh, gst_event_new_eos()));
+    got = pull_all(hh, bufs, n);
+    CHECK_EQ_INT(got, n);
+    gst_harness_teardown(hh);
+    return got;
+}
+
+/* threads: the warp in bands on a pool gives one thread's bytes, in every format, also when
+ * the count changes while streaming (and 0, automatic, is accepted). */
+void test_gst_threads_same_bytes(void)
+{
+    enum { N = 16 };
+    static const char *formats[] = {"I420", "NV12", "YUY2", "GRAY8"};
+    static const int counts[][2] = {{2, 2}, {3, 3}, {1, 3}, {4, 0}};
+    size_t f, c;
+    for (f = 0; f < G_N_ELEMENTS(formats); f++) {
+        GstBuffer *ref[N], *out[N];
+        int n = run_clip_threads(formats[f], 1, 1, N, ref), i;
+        for (c = 0; c < G_N_ELEMENTS(counts); c++) {
+            int m = run_clip_threads(formats[f], counts[c][0], counts[c][1], N, out), same = m == n;
+            for (i = 0; i < m && i < n; i++) {
+                GstMapInfo a, b;
+                gst_buffer_map(ref[i], &a, GST_MAP_READ);
+                gst_buffer_map(out[i], &b, GST_MAP_READ);
+                same &= a.size == b.size && !memcmp(a.data, b.data, a.size);
+                gst_buffer_unmap(out[i], &b);
+                gst_buffer_unmap(ref[i], &a);
+            }
+            if (!same) fprintf(stderr, "    %s, threads %d then %d: differs from one thread\n", formats[f], counts[c][0], counts[c][1]);
+            CHECK(same);
+            unref_all(out, m);
+        }
+        unref_all(ref, n);
+    }
+}
+
 #define TEST_LIST(X) \
     X(gst_frames_out_equal_in_causal) X(gst_frames_out_equal_in_lookahead8) X(gst_latency) \
     X(gst_flush_drops_held) X(gst_renegotiation) X(gst_refuses_caps) X(gst_timestamps_preserved) \
     X(gst_still_identity_every_format) X(gst_formats_agree) X(gst_statistics_messages) \
-    X(gst_settings_while_streaming) X(gst_invalid_settings_refused) X(gst_pooled_input_copied)
+    X(gst_settings_while_streaming) X(gst_invalid_settings_refused) X(gst_pooled_input_copied) \
+    X(gst_threads_same_bytes)
 
 #define DECLARE(name) void test_##name(void);
 TEST_LIST(DECLARE)

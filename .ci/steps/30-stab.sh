@@ -49,9 +49,20 @@ if command -v clang > /dev/null; then
   $tsan_stab --quiet --threads 2 --lookahead 3 "$stab_dir/clip.y4m" /dev/full 2> /dev/null || st_full=$?
   if [ $st -eq 0 ] && [ $st_full -eq 2 ] && cmp -s "$tmp/tsan.y4m" "$tmp/plain.y4m" && cmp -s "$tmp/tsan.csv" "$tmp/plain.csv"; then
     ok stab_cli_threads_tsan; else fail stab_cli_threads_tsan "exit $st, to /dev/full $st_full"; fi
+  # eis-v4l2's warp pool on the fake device: no race, one thread's bytes
+  make -j2 BUILD=build-tsan CC=clang SANITIZE=thread build-tsan/bin/eis-v4l2 build-tsan/lib/fake_v4l2.so > /dev/null
+  st=0
+  for t in 1 3; do
+    FAKE_V4L2_CLIP="$stab_dir/clip.y4m" FAKE_V4L2_FORMAT=nv12 LD_PRELOAD=build-tsan/lib/fake_v4l2.so \
+      setarch "$(uname -m)" -R build-tsan/bin/eis-v4l2 --no-window --quiet --frames 30 --lookahead 3 --threads $t \
+      --output "$tmp/eis_tsan$t.y4m" || st=$?
+  done
+  if [ $st -eq 0 ] && cmp -s "$tmp/eis_tsan1.y4m" "$tmp/eis_tsan3.y4m"; then
+    ok stab_v4l2_threads_tsan; else fail stab_v4l2_threads_tsan "exit $st"; fi
   unset TSAN_OPTIONS
 else
   fail stab_cli_threads_tsan "clang not installed"
+  fail stab_v4l2_threads_tsan "clang not installed"
 fi
 # with the dependencies installed, none of the optional checks may have been skipped
 for name in stab_y4m_matches_ffmpeg stab_v4l2_injected_faults stab_v4l2_disconnect_clean_exit stab_libcamera_no_camera; do

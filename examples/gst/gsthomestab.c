@@ -16,12 +16,19 @@
  * Memory: the stabiliser's arena is allocated once per configuration (the library itself never
  * allocates). Held frames that come from an upstream buffer pool (a camera's few buffers) are
  * copied into the element's own pool (lookahead + 1 buffers at most, allocated as first needed),
- * so upstream gets its buffers back at once; other input buffers are held by reference. */
+ * so upstream gets its buffers back at once; other input buffers are held by reference.
+ *
+ * Threads: with threads = N > 1 the warp runs in N row bands (home_stab_warp_rows) on a fixed
+ * pool of N - 1 workers and the streaming thread (examples/eis_pool.h), started at the first
+ * warp and kept; the bytes are one thread's. Registration does not overlap the warp here, as it
+ * does in eis-v4l2: the base class renders each frame in the call that pushed its successor,
+ * and overlapping them would hold every frame one more frame. */
 #include <gst/gst.h>
 #include <gst/video/video.h>
 #include <gst/video/gstvideofilter.h>
 #include <string.h>
 #include "home_stab.h"
+#include "eis_pool.h"
 
 /* GST_PLUGIN_DEFINE names the package */
 #define PACKAGE "libhome"
@@ -53,6 +60,7 @@ struct _GstHomeStab {
     gfloat smoothing, ease;
     gint downscale, keypoints, refine_finest, hough_downscale, theta_bins;
     gboolean refine, post_messages;
+    gint threads;                 /* 0: eis_pool_auto_threads() */
     gboolean settings_changed;    /* since the stabiliser was configured */
     gboolean cut_requested;       /* the "cut" action signal, for the next frame */
 
@@ -69,6 +77,7 @@ struct _GstHomeStab {
     const home_stab_output *rendering; /* the output transform_frame applies */
     GstBufferPool *copy_pool;     /* for held frames from upstream pools; NULL without lookahead */
     GstClockTime last_duration;   /* of the last input buffer: the latency without a framerate */
+    eis_pool *pool;               /* the warp's threads; NULL until the first warp */
 };
 
 G_DEFINE_TYPE(GstHomeStab, gst_home_stab, GST_TYPE_VIDEO_FILTER)
@@ -87,7 +96,8 @@ enum {
     PROP_REFINE_FINEST,
     PROP_HOUGH_DOWNSCALE,
     PROP_THETA_BINS,
-    PROP_POST_MESSAGES
+    PROP_POST_MESSAGES,
+    PROP_THREADS
 };
 
 enum { SIGNAL_CUT, N_SIGNALS };
@@ -193,11 +203,13 @@ static void release_copy_pool(GstHomeStab *self)
     self->copy_pool = NULL;
 }
 
-/* Everything of the current configuration: held frames, the pool, the arena. */
+/* Everything of the current configuration: held frames, the pools, the arena. */
 static void release_all(GstHomeStab *self)
 {
     drop_held(self);
     release_copy_pool(self);
+    eis_pool_stop(self->pool);
+    self->pool = NULL;
     self->stab = NULL;
     g_free(self->arena_block);
     self->arena_block = NULL;
@@ -499,14 +511,24 @@ static GstFlowReturn gst_home_stab_transform_frame(GstVideoFilter *filter, GstVi
 {
     GstHomeStab *self = GST_HOME_STAB(filter);
     home_stab_image src, dst;
-    int status;
+    int status, threads;
     if (!self->rendering) {   /* only render() sends frames this way */
         GST_ELEMENT_ERROR(self, STREAM, FAILED, (NULL), ("a frame reached the transform without a warp"));
         return GST_FLOW_ERROR;
     }
+    GST_OBJECT_LOCK(self);
+    threads = self->threads ? self->threads : eis_pool_auto_threads();
+    GST_OBJECT_UNLOCK(self);
+    if (self->pool && eis_pool_threads(self->pool) != threads) {
+        eis_pool_stop(self->pool);
+        self->pool = NULL;
+    }
+    if (!self->pool && threads > 1 && eis_pool_start(&self->pool, threads))
+        GST_WARNING_OBJECT(self, "cannot start %d threads: warping on one", threads);
     frame_image(in_frame, &src);
     frame_image(out_frame, &dst);
-    status = home_stab_warp(self->rendering->warp, &src, &dst);
+    status = self->pool ? eis_pool_warp(self->pool, self->rendering->warp, &src, &dst)
+                        : home_stab_warp(self->rendering->warp, &src, &dst);
     if (status != HOME_OK) {
         GST_ELEMENT_ERROR(self, STREAM, FAILED, (NULL), ("warp: %s", home_strerror(status)));
         return GST_FLOW_ERROR;
@@ -607,6 +629,7 @@ static void gst_home_stab_set_property(GObject *object, guint prop_id, const GVa
     case PROP_HOUGH_DOWNSCALE: self->hough_downscale = g_value_get_int(value); break;
     case PROP_THETA_BINS: self->theta_bins = g_value_get_int(value); break;
     case PROP_POST_MESSAGES: self->post_messages = g_value_get_boolean(value); settings = FALSE; break;
+    case PROP_THREADS: self->threads = g_value_get_int(value); settings = FALSE; break;   /* at the next warp */
     default: settings = FALSE; G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
     }
     if (settings) self->settings_changed = TRUE;
@@ -631,6 +654,7 @@ static void gst_home_stab_get_property(GObject *object, guint prop_id, GValue *v
     case PROP_HOUGH_DOWNSCALE: g_value_set_int(value, self->hough_downscale); break;
     case PROP_THETA_BINS: g_value_set_int(value, self->theta_bins); break;
     case PROP_POST_MESSAGES: g_value_set_boolean(value, self->post_messages); break;
+    case PROP_THREADS: g_value_set_int(value, self->threads); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
     }
     GST_OBJECT_UNLOCK(self);
@@ -665,6 +689,7 @@ static void gst_home_stab_init(GstHomeStab *self)
     self->hough_downscale = d.hough_downscale;
     self->theta_bins = d.theta_bins;
     self->last_duration = GST_CLOCK_TIME_NONE;
+    self->threads = 1;
     /* every frame is registered to the one before: a frame dropped for lateness would be a
      * motion the path never sees */
     gst_base_transform_set_qos_enabled(GST_BASE_TRANSFORM(self), FALSE);
@@ -735,6 +760,12 @@ static void gst_home_stab_class_init(GstHomeStabClass *klass)
         g_param_spec_boolean("post-messages", "Post messages",
                              "Post an element message \"homestab\" per output frame with its raw and "
                              "smoothed camera path and motion status", FALSE, rw));
+
+    g_object_class_install_property(gobject_class, PROP_THREADS,
+        g_param_spec_int("threads", "Threads",
+                         "Threads for the warp, in row bands, the streaming thread counted (the same "
+                         "bytes for any count); 0 = the online CPUs, at most " G_STRINGIFY(EIS_POOL_AUTO_MAX),
+                         0, EIS_POOL_MAX_THREADS, 1, rw));
 
     /* Declare a scene cut before the next frame (an edit or a stream switch the application
      * knows of): the path restarts there, nothing held is lost. */

@@ -2,10 +2,10 @@
 # as gst-launch-1.0 sees it. gst-inspect-1.0 homestab; a videotestsrc pipeline per format
 # (every frame out); a live pipeline whose sink drops late frames (the lookahead's latency is
 # reported, so none are late); `filesrc ! y4mdec ! homestab ! y4menc` byte-identical to
-# home-stab --fixed-crop with the same options (frame payloads: the Y4M headers' tags differ);
-# `make install` put the plugin in GStreamer's plugin directory. Skipped, saying why, without
-# the plugin or GStreamer's tools (gstreamer1.0-tools, y4menc from plugins-good, y4mdec from
-# plugins-bad).
+# home-stab --fixed-crop with the same options, also with the warp on 3 threads (frame
+# payloads: the Y4M headers' tags differ); `make install` put the plugin in GStreamer's plugin
+# directory. Skipped, saying why, without the plugin or GStreamer's tools (gstreamer1.0-tools,
+# y4menc from plugins-good, y4mdec from plugins-bad).
 gst_plugin_dir="$BUILD/lib/gstreamer-1.0"
 gst_missing=""
 for gst_tool in gst-launch-1.0 gst-inspect-1.0; do
@@ -31,7 +31,7 @@ else
      grep -q 'HOME video stabiliser' "$gst_dir/inspect.txt" &&
      grep -q 'GRAY8' "$gst_dir/inspect.txt" &&
      ( for p in lookahead margin margin-x margin-y smoothing ease downscale keypoints refine refine-finest \
-                hough-downscale theta-bins post-messages; do grep -q "^  $p  *:" "$gst_dir/inspect.txt" || exit 1; done ); then
+                hough-downscale theta-bins post-messages threads; do grep -q "^  $p  *:" "$gst_dir/inspect.txt" || exit 1; done ); then
     ok gst_inspect
   else fail gst_inspect "$(head -c 300 "$gst_dir/inspect.txt")"; fi
 
@@ -84,6 +84,7 @@ PY
   }
   for case in "0|--lookahead 0|lookahead=0" \
               "8|--lookahead 8 --ease 0.3 --margin-x 0.06 --margin-y 0.12|lookahead=8 ease=0.3 margin-x=0.06 margin-y=0.12" \
+              "8_threads3|--lookahead 8 --ease 0.3 --margin-x 0.06 --margin-y 0.12|lookahead=8 ease=0.3 margin-x=0.06 margin-y=0.12 threads=3" \
               "12|--lookahead 12 --smoothing 5 --margin 0.08 --keypoints 300 --theta-bins 64|lookahead=12 smoothing=5 margin=0.08 keypoints=300 theta-bins=64"; do
     IFS='|' read -r n stab_opts gst_opts <<< "$case"
     rm -f "$gst_dir/ref.y4m" "$gst_dir/gst.y4m"

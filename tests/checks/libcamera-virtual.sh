@@ -6,7 +6,8 @@
 # it through the memfd buffer fallback (no /dev/dma_heap, no /dev/udmabuf here), writes the
 # frames as captured and as stabilised, and tests/support/virtual_camera_check.py checks them:
 # every frame out, the images played in order, the same bytes as home-stab --fixed-crop on
-# the captured frames, and the residual jitter below half the input's.
+# the captured frames, and the residual jitter below half the input's; then causal runs on one
+# thread and on three (the warp pool) give the same bytes.
 # libcamera (built without udev) enumerates media devices through /sys/bus/media/devices, which
 # a machine without any media driver lacks: the camera runs in a private mount namespace
 # (unshare -m, root or sudo) with a tmpfs over /sys/bus holding that directory, and the
@@ -84,4 +85,18 @@ PY
     ok "libcamera_virtual_stabilises ($(tail -n 1 "$lcv_t/check.txt"))"
   else fail libcamera_virtual_stabilises "$(cat "$lcv_t/check.txt")"; fi
   sed 's/^/    /' "$lcv_t/check.txt" | head -n 4
+  # the warp pool, causal (each repeat is written once its frame's output job is done): one
+  # thread and three give the same bytes for the same captured frames, and every image is
+  # registered once (a causal ring of one frame once took every frame for a repeat)
+  for t in 1 3; do
+    lcv_run --size 640x360 --format nv12 --frames $lcv_frames --lookahead 0 --threads $t \
+      --output "$lcv_t/out_t$t.y4m" --raw-output "$lcv_t/raw_t$t.y4m" > /dev/null 2> "$lcv_t/eis_t$t.err"
+    echo $? > "$lcv_t/st_t$t"
+  done
+  if [ "$(cat "$lcv_t/st_t1") $(cat "$lcv_t/st_t3")" = "0 0" ] && grep -q '^eis-libcamera: 3 thread(s)$' "$lcv_t/eis_t3.err" &&
+     grep -q "($lcv_images registered" "$lcv_t/eis_t1.err" &&
+     cmp -s "$lcv_t/raw_t1.y4m" "$lcv_t/raw_t3.y4m" && cmp -s "$lcv_t/out_t1.y4m" "$lcv_t/out_t3.y4m" &&
+     [ "$(grep -a -c FRAME "$lcv_t/out_t3.y4m")" -eq $lcv_frames ]; then
+    ok libcamera_virtual_threads_same_bytes
+  else fail libcamera_virtual_threads_same_bytes "exit $(cat "$lcv_t/st_t1") / $(cat "$lcv_t/st_t3"), $(tail -c 300 "$lcv_t/eis_t3.err")"; fi
 fi

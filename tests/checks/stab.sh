@@ -157,6 +157,29 @@ PY
       ok "stab_v4l2_${1}_mplane$2_pad$3"
     else fail "stab_v4l2_${1}_mplane$2_pad$3" "exit $st, $(y4m_shape "$stab_dir/eis.y4m"), $(tail -c 300 "$stab_dir/eis.err")"; fi
   done
+  # the warp on the pool (--threads N: row bands on N - 1 workers, overlapping the next
+  # registration) gives one thread's bytes: formats, APIs, lookaheads (0: each frame is due as
+  # it is pushed), 30 frames of the 24-frame clip (it loops: a jump back to frame 0)
+  for case in "nv12 0 32 4" "yuyv 1 8 0" "yu12 0 0 6"; do
+    set -- $case
+    eis FAKE_V4L2_FORMAT=$1 FAKE_V4L2_MPLANE=$2 FAKE_V4L2_PAD=$3 -- --frames 30 --lookahead $4 --threads 1 --output "$stab_dir/eis_t1.y4m"
+    why=""; [ $st -eq 0 ] && [ "$(y4m_shape "$stab_dir/eis_t1.y4m")" = "30 320 180 420jpeg" ] || why="--threads 1: exit $st"
+    for t in 2 3; do
+      eis FAKE_V4L2_FORMAT=$1 FAKE_V4L2_MPLANE=$2 FAKE_V4L2_PAD=$3 -- --frames 30 --lookahead $4 --threads $t --output "$stab_dir/eis_t$t.y4m"
+      { [ $st -eq 0 ] && grep -q "^eis-v4l2: $t thread(s)$" "$stab_dir/eis.err" && cmp -s "$stab_dir/eis_t1.y4m" "$stab_dir/eis_t$t.y4m"; } ||
+        why="$why --threads $t: exit $st, $(cmp "$stab_dir/eis_t1.y4m" "$stab_dir/eis_t$t.y4m" 2>&1 | head -c 100)"
+    done
+    if [ -z "$why" ]; then ok "stab_v4l2_threads_same_bytes_$1_lookahead$4"; else fail "stab_v4l2_threads_same_bytes_$1_lookahead$4" "$why"; fi
+  done
+  # a failing output ends the run with exit 2 whichever thread writes
+  full_ok=1
+  if [ -w /dev/full ]; then
+    for t in 1 2 3; do
+      eis -- --frames 30 --lookahead 2 --threads $t --output /dev/full
+      { [ $st -eq 2 ] && grep -q 'write error' "$stab_dir/eis.err"; } || { full_ok=0; echo "    --threads $t to /dev/full: exit $st"; }
+    done
+  fi
+  if [ $full_ok -eq 1 ]; then ok stab_v4l2_threads_write_error_exits; else fail stab_v4l2_threads_write_error_exits "no clean exit 2"; fi
   eis FAKE_V4L2_FAULTS=eintr@2,dqeintr@4,eagain@6,eio@8,error@10,short@12,drop@14 -- --frames 16 --output "$stab_dir/eis.y4m"
   if [ $st -eq 0 ] && [ "$(y4m_shape "$stab_dir/eis.y4m")" = "16 320 180 420jpeg" ] &&
      grep -q 'eintr=1 dqeintr=1 eagain=1 eio=1 error=1 short=1 drop=1' "$stab_dir/eis.log" &&

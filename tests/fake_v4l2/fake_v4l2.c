@@ -16,6 +16,8 @@
  *                      short (bytesused half a frame, contents garbage), drop (a clip frame
  *                      is skipped), stall (select times out), disconnect (ENODEV from then on)
  *   FAKE_V4L2_LOG      file to which a summary line is appended at close
+ *   FAKE_V4L2_FPS      frames come no faster than this, as from a camera: frame k is ready
+ *                      k / FPS s after STREAMON (select/poll sleep until then); default: at once
  * The clip size is the only size the driver offers: S_FMT adjusts the request to it. */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -30,6 +32,7 @@
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/select.h>
+#include <time.h>
 #include <unistd.h>
 
 #define FAKE_MAX_BUFFERS 8
@@ -51,6 +54,7 @@ typedef struct fake_state {
     struct { int kind; long at; int done; } faults[FAKE_MAX_FAULTS];
     int n_faults;
     long fired[F_KINDS];
+    double fps, t_stream_on;       /* FAKE_V4L2_FPS; CLOCK_MONOTONIC s at STREAMON */
 } fake_state;
 
 static fake_state S;   /* every use checks S.ready first */
@@ -72,6 +76,13 @@ static void *next_symbol(const char *name)
     return dlsym(RTLD_NEXT, name);
 }
 #define REAL(type, name, sym) type name; { void *p_ = next_symbol(sym); memcpy(&name, &p_, sizeof name); }
+
+static double monotonic_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
+}
 
 static const char *device_path(void)
 {
@@ -171,6 +182,7 @@ static int fake_open(const char *path)
         S.mplane = getenv("FAKE_V4L2_MPLANE") && atoi(getenv("FAKE_V4L2_MPLANE"));
         S.forced = parse_format(getenv("FAKE_V4L2_FORMAT"));
         S.pad = getenv("FAKE_V4L2_PAD") ? atoi(getenv("FAKE_V4L2_PAD")) : 0;
+        S.fps = getenv("FAKE_V4L2_FPS") ? atof(getenv("FAKE_V4L2_FPS")) : 0;
         S.ready = 1;
     }
     (void)path;
@@ -413,7 +425,7 @@ static int fake_ioctl(unsigned long request, void *arg)
         return 0;
     }
     case VIDIOC_DQBUF: return dqbuf(arg);
-    case VIDIOC_STREAMON: S.streaming = 1; return 0;
+    case VIDIOC_STREAMON: S.streaming = 1; S.t_stream_on = monotonic_s(); return 0;
     case VIDIOC_STREAMOFF: S.streaming = 0; S.count = S.head = 0; memset(S.queued, 0, sizeof S.queued); return 0;
     default: errno = ENOTTY; return -1;
     }
@@ -466,6 +478,19 @@ int munmap(void *addr, size_t len)
     return real_munmap(addr, len);
 }
 
+/* With FAKE_V4L2_FPS: sleep until the next frame is due (a late reader finds it ready). */
+static void pace(void)
+{
+    double wait;
+    struct timespec ts;
+    if (S.fps <= 0) return;
+    wait = S.t_stream_on + (double)S.clip_pos / S.fps - monotonic_s();
+    if (wait <= 0) return;
+    ts.tv_sec = (time_t)wait;
+    ts.tv_nsec = (long)((wait - (double)ts.tv_sec) * 1e9);
+    nanosleep(&ts, NULL);
+}
+
 /* 1: a frame can be dequeued (or an error is pending); 0: timeout; -1 EINTR */
 static int fake_wait(void)
 {
@@ -473,6 +498,7 @@ static int fake_wait(void)
     if (fault_now(F_DISCONNECT)) S.disconnected = 1;
     if (S.disconnected) return 1;
     if (fault_now(F_STALL)) return 0;
+    if (S.streaming && S.count) pace();
     return S.streaming && S.count ? 1 : 0;
 }
 
