@@ -20,16 +20,9 @@ for bin in eis-v4l2 eis-libcamera home-stab home-stab-clip; do
 done
 nm -u "$BUILD/bin/eis-v4l2" | grep -q SDL_CreateWindow || { echo "30-stab: eis-v4l2 built without SDL2"; exit 1; }
 
-passed=0
-failed=0
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-ok() { passed=$((passed + 1)); echo "ok   $1"; echo "$1" >> "$tmp/passed"; }
-fail() { failed=$((failed + 1)); echo "FAIL $1${2:+: $2}"; }
-RUNNER=""
-"$BUILD/bin/home-stab-tests" | tee "$tmp/unit.out" || true
-line=$(tail -n 1 "$tmp/unit.out")
-[[ $line =~ ^([0-9]+)\ passed,\ 0\ failed$ ]] && ok home-stab-tests || fail home-stab-tests "$line"
+# shellcheck source=../checks.sh
+. .ci/checks.sh
+unit_tests "$BUILD/bin/home-stab-tests" home-stab-tests
 # the checks run commands that are meant to fail (as under tests/run.sh, which has no set -e)
 set +eu
 # shellcheck source=/dev/null
@@ -65,11 +58,8 @@ else
   fail stab_v4l2_threads_tsan "clang not installed"
 fi
 # with the dependencies installed, none of the optional checks may have been skipped
-for name in stab_y4m_matches_ffmpeg stab_v4l2_injected_faults stab_v4l2_disconnect_clean_exit stab_libcamera_no_camera; do
-  grep -qx "$name" "$tmp/passed" || fail "$name" "did not run"
-done
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+require_checks stab_y4m_matches_ffmpeg stab_v4l2_injected_faults stab_v4l2_disconnect_clean_exit \
+  stab_libcamera_no_camera
 
 echo "--- bench/stab smoke run (the full comparison: python3 bench/stab/compare.py)"
 python3 -c 'import numpy' 2> /dev/null || pip install -q numpy

@@ -19,29 +19,18 @@ for f in lib/gstreamer-1.0/libgsthome.so bin/home-gst-tests; do
   [ -e "$BUILD/$f" ] || { echo "60-gst: $f was not built"; exit 1; }
 done
 
-passed=0
-failed=0
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-ok() { passed=$((passed + 1)); echo "ok   $1"; echo "$1" >> "$tmp/passed"; }
-fail() { failed=$((failed + 1)); echo "FAIL $1${2:+: $2}"; }
-RUNNER=""
+# shellcheck source=../checks.sh
+. .ci/checks.sh
 # a writable registry in the build directory, this plugin on the path (the harness tests load
 # only the element compiled into them and ignore both)
 export GST_REGISTRY="$PWD/$BUILD/gst-registry.bin"
 export GST_PLUGIN_PATH="$PWD/$BUILD/lib/gstreamer-1.0"
-"$BUILD/bin/home-gst-tests" | tee "$tmp/unit.out" || true
-line=$(tail -n 1 "$tmp/unit.out")
-[[ $line =~ ^([0-9]+)\ passed,\ 0\ failed$ ]] && ok home-gst-tests || fail home-gst-tests "$line"
+unit_tests "$BUILD/bin/home-gst-tests" home-gst-tests
 # gst.sh checks make install's result in $tmp/dest, as tests/run.sh lays it out
 make -s install BUILD=$BUILD DESTDIR="$tmp/dest" PREFIX=/opt/home > /dev/null
 set +eu
 # shellcheck source=/dev/null
 . tests/checks/gst.sh
 set -eu
-for name in gst_inspect gst_pipeline_I420 gst_pipeline_NV12 gst_pipeline_YUY2 gst_pipeline_GRAY8 \
-            gst_live_latency gst_same_bytes_as_home_stab_lookahead8 gst_make_install; do
-  grep -qx "$name" "$tmp/passed" || fail "$name" "did not run"
-done
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+require_checks gst_inspect gst_pipeline_I420 gst_pipeline_NV12 gst_pipeline_YUY2 gst_pipeline_GRAY8 \
+  gst_live_latency gst_same_bytes_as_home_stab_lookahead8 gst_make_install

@@ -22,19 +22,10 @@ start=$(date +%s)
 make -j2 BUILD=$BUILD libcamera-virtual
 echo "70-libcamera: libcamera and eis-libcamera built in $(( $(date +%s) - start )) s"
 
-passed=0
-failed=0
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-ok() { passed=$((passed + 1)); echo "ok   $1"; echo "${1%% (*}" >> "$tmp/passed"; }
-fail() { failed=$((failed + 1)); echo "FAIL $1${2:+: $2}"; }
-RUNNER=""
+# shellcheck source=../checks.sh
+. .ci/checks.sh
 set +eu
 # shellcheck source=/dev/null
 . tests/checks/libcamera-virtual.sh
 set -eu
-for name in libcamera_virtual_lists_camera libcamera_virtual_capture libcamera_virtual_stabilises; do
-  grep -qx "$name" "$tmp/passed" || fail "$name" "did not run"
-done
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+require_checks libcamera_virtual_lists_camera libcamera_virtual_capture libcamera_virtual_stabilises
