@@ -8,7 +8,8 @@
 //     the previous frame's cached descriptors + findHomography(RANSAC).
 //   Head to head: the ORB frame and the HOME video frames (home_video_config, and the same
 //     with the refinement ending at full size; the automatic backend) timed in rotation, 5x
-//     runs of each, so load on a shared machine hits all alike.
+//     runs of each, so load on a shared machine hits all alike; then the still-pair protocol:
+//     ORB on both images + matching + homography against home_register() with the defaults.
 // Prints a table and the ratios; usage: home-bench [runs]
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -99,6 +100,11 @@ struct OrbPipeline {
     std::vector<cv::KeyPoint> ka, kb;
     cv::Mat da, db;
     explicit OrbPipeline(const cv::Mat &ma) { orb->detectAndCompute(ma, cv::noArray(), ka, da); }
+    // a still pair: both images' features, then as frame()
+    cv::Mat pair(const cv::Mat &ma, const cv::Mat &mb) {
+        orb->detectAndCompute(ma, cv::noArray(), ka, da);
+        return frame(mb);
+    }
     // one new frame: features, matches against A's, homography (A -> B), empty if too few
     cv::Mat frame(const cv::Mat &mb) {
         orb->detectAndCompute(mb, cv::noArray(), kb, db);
@@ -165,6 +171,32 @@ static bool head_to_head(int w, int h, const std::vector<uint8_t> &a, const std:
     orb_ms = median(t_orb);
     home_ms[0] = median(t_home[0]);
     home_ms[1] = median(t_home[1]);
+    return true;
+}
+
+// The still-pair protocol in rotation, runs times each: ORB on both images + matching +
+// homography, and home_register() with the defaults (the automatic backend); medians.
+static bool pair_head_to_head(int w, int h, const std::vector<uint8_t> &a,
+                              const std::vector<uint8_t> &b, int runs, double &orb_ms,
+                              double &home_ms) {
+    cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data());
+    OrbPipeline orb(ma);
+    home_config cfg;
+    preset_config(0, w, h, cfg);
+    HomeContext home(cfg);
+    if (!home.ctx) return false;
+    home_result res;
+    std::vector<double> t_orb, t_home;
+    for (int i = 0; i < runs; i++) {
+        double t0 = now_ms(nullptr);
+        orb.pair(ma, mb);
+        t_orb.push_back(now_ms(nullptr) - t0);
+        t0 = now_ms(nullptr);
+        home_register(home.ctx, a.data(), w, b.data(), w, &res);
+        t_home.push_back(now_ms(nullptr) - t0);
+    }
+    orb_ms = median(t_orb);
+    home_ms = median(t_home);
     return true;
 }
 
@@ -266,6 +298,11 @@ int main(int argc, char **argv) {
                    "%.2f ms, ORB/HOME %.2f; video-full frame %.2f ms, ORB/HOME %.2f\n",
                    5 * runs, backend, h2h_orb, h2h_home[0], h2h_orb / h2h_home[0], h2h_home[1],
                    h2h_orb / h2h_home[1]);
+        double pair_orb, pair_home;
+        if (pair_head_to_head(w, h, a, b, 5 * runs, pair_orb, pair_home))
+            printf("still pairs head to head (in rotation, %d runs each): ORB pair %.2f ms; HOME "
+                   "defaults pair %.2f ms, HOME/ORB %.2f\n",
+                   5 * runs, pair_orb, pair_home, pair_home / pair_orb);
         printf("\n");
     }
     return 0;
