@@ -183,6 +183,11 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
  * context's sizes, cfg and r_bins, already set). */
 size_t home__hough_bytes(const home_config *cfg);
 void home__hough_init(home_context *ctx, unsigned char *block);
+/* Rows [y0, y1) of the image the Hough transform sees (box-downscaled when hough_downscale > 1)
+ * from image; FAST only. */
+void home__hough_load_rows(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int y0,
+                           int y1);
+/* J row by row to on_row; image NULL: its rows were all loaded with home__hough_load_rows(). */
 double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t stride,
                           home__row_fn on_row, void *user);
 
@@ -275,6 +280,12 @@ void home__refine_defaults(home_config *cfg);
 int home__refine_validate(const home_config *cfg);
 size_t home__refine_bytes(const home_config *cfg);
 void home__refine_init(home_context *ctx, unsigned char *block);
+/* Where the snapshot's 2x2-mean frame is built when it starts at half size (its rows in *rows),
+ * else NULL; home__refine_half_rows() fills its rows [y0, y1) from the full-size image. */
+uint8_t *home__refine_half_frame(home_context *ctx, int *rows);
+void home__refine_half_rows(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int y0,
+                            int y1);
+/* Snapshot of a frame; image NULL: the 2x2-mean frame was filled by home__refine_half_rows(). */
 uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride);
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result);
 

@@ -43,15 +43,12 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
 
 static void prefix_edges(home_context *ctx);
 
-/* Copy the image (box-downscaled when hough_downscale is 2 or 4) into the zero-padded buffers
- * (HOME__RADON_BLOCK columns each side) used by the shear-and-add kernel: img_n as is, img_t
- * transposed from it; then the border prefix sums. */
-static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
+void home__hough_load_rows(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int y0,
+                           int y1)
 {
-    const int width = ctx->hough_w, height = ctx->hough_h, pad = HOME__RADON_BLOCK;
-    const int ds = ctx->hough_scale;
-    int x, y;
-    for (y = 0; y < height; y++) {
+    const int width = ctx->hough_w, pad = HOME__RADON_BLOCK, ds = ctx->hough_scale;
+    int y;
+    for (y = y0; y < y1; y++) {
         uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
         memset(row, 0, (size_t)pad);
         if (ds > 1)
@@ -61,6 +58,16 @@ static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stri
             memcpy(row + pad, image + (ptrdiff_t)y * stride, (size_t)width);
         memset(row + pad + width, 0, (size_t)pad);
     }
+}
+
+/* The image (box-downscaled when hough_downscale is 2 or 4) in the zero-padded buffers
+ * (HOME__RADON_BLOCK columns each side) used by the shear-and-add kernel: img_n as is (loaded
+ * here unless image is NULL), img_t transposed from it; then the border prefix sums. */
+static void prepare_fast(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
+{
+    const int width = ctx->hough_w, height = ctx->hough_h, pad = HOME__RADON_BLOCK;
+    int x, y;
+    if (image) home__hough_load_rows(ctx, image, stride, 0, height);
     for (x = 0; x < width; x++) {
         uint8_t *row = ctx->img_t + (ptrdiff_t)x * ctx->img_t_stride;
         memset(row, 0, (size_t)pad);

@@ -118,12 +118,31 @@ static void fill_keypoints(const home_context *ctx, home__heap *heap, int sign, 
     }
 }
 
+/* When the Hough image is a box-downscaled copy and the refinement's snapshot starts from the
+ * 2x2-mean frame, both are made in one pass over the frame: each band of hough_downscale rows
+ * comes from memory once, for the box and (still in cache) the 2x2 means; the same bytes as two
+ * passes. Returns 1 when done (both consumers then skip their own pass). */
+static int read_frame_once(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
+{
+    const int ds = ctx->hough_scale;
+    int y, half_rows;
+    if (ds < 2 || ctx->cfg.hough_method != HOME_HOUGH_FAST ||
+        !home__refine_half_frame(ctx, &half_rows))
+        return 0;
+    for (y = 0; y < ctx->hough_h; y++) {
+        home__hough_load_rows(ctx, image, stride, y, y + 1);
+        home__refine_half_rows(ctx, image, stride, y * ds / 2, (y + 1) * ds / 2);
+    }
+    home__refine_half_rows(ctx, image, stride, ctx->hough_h * ds / 2, half_rows);
+    return 1;
+}
+
 int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home_features *out)
 {
     extract_state st;
-    double n_values, mean, var, t_end;
+    double n_values, mean, var, t_end, t_read;
     float scale;
-    int status = check_ctx(ctx);
+    int read_once, status = check_ctx(ctx);
     if (status != HOME_OK) return status;
     if (!out) return HOME_E_NULL;
     status = home__check_image(ctx, image, stride);
@@ -135,7 +154,10 @@ int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home
     home__heap_init(&st.pos, ctx->heap_entries, ctx->heap_items, ctx->cfg.keypoints_per_sign);
     home__heap_init(&st.neg, ctx->heap_entries + ctx->cfg.keypoints_per_sign,
                     ctx->heap_items + ctx->cfg.keypoints_per_sign, ctx->cfg.keypoints_per_sign);
-    out->ms_hough = home__hough_stream(ctx, image, stride, on_row, &st);
+    t_read = home__now(ctx);
+    read_once = read_frame_once(ctx, image, stride);
+    t_read = home__now(ctx) - t_read; /* counted as the Hough stage's */
+    out->ms_hough = t_read + home__hough_stream(ctx, read_once ? NULL : image, stride, on_row, &st);
 
     n_values = (double)ctx->cfg.theta_bins * ctx->r_bins;
     mean = st.sum / n_values;
@@ -151,7 +173,7 @@ int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home
     out->ms_detect = st.ms_detect;
     out->ms_describe = st.ms_describe + (home__now(ctx) - t_end);
     t_end = home__now(ctx);
-    out->frame_id = home__refine_store(ctx, image, stride);
+    out->frame_id = home__refine_store(ctx, read_once ? NULL : image, stride);
     out->ms_refine = home__now(ctx) - t_end;
     out->width = ctx->cfg.width;
     out->height = ctx->cfg.height;

@@ -321,6 +321,31 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
     for (; n % LANES; n++) out->x[n] = out->y[n] = out->t[n] = 0;
 }
 
+/* The selection's block cells, in the scratch after a row of int16 */
+static uint16_t *scratch_cells(const home__refine_state *st)
+{
+    return (uint16_t *)(void *)((unsigned char *)st->scratch +
+                                align64((size_t)st->w[0] * sizeof(int16_t)));
+}
+
+uint8_t *home__refine_half_frame(home_context *ctx, int *rows)
+{
+    home__refine_state *st = &ctx->refine;
+    if (!st->levels || st->base_level == 0) return NULL;
+    *rows = st->h[1];
+    return (uint8_t *)scratch_cells(st); /* free until the point selection */
+}
+
+void home__refine_half_rows(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int y0,
+                            int y1)
+{
+    home__refine_state *st = &ctx->refine;
+    uint8_t *half = (uint8_t *)scratch_cells(st);
+    if (y1 > y0)
+        st->rk->downsample(image + 2 * (ptrdiff_t)y0 * stride, stride,
+                           half + (ptrdiff_t)y0 * st->w[1], st->w[1], st->w[1], y1 - y0);
+}
+
 uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
 {
     home__refine_state *st = &ctx->refine;
@@ -329,13 +354,12 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     uint16_t *cells;
     if (!st->levels) return 0; /* refinement off: no scratch (arithmetic on NULL is undefined) */
     row_tmp = (int16_t *)st->scratch;
-    cells = (uint16_t *)(void *)((unsigned char *)st->scratch +
-                                 align64((size_t)st->w[0] * sizeof(int16_t)));
+    cells = scratch_cells(st);
     if (st->base_level == 0) {
         st->rk->blur3(image, stride, st->pyr[0], st->w[0], st->w[0], st->h[0], row_tmp);
     } else {
-        uint8_t *half = (uint8_t *)cells; /* free until the selection below */
-        st->rk->downsample(image, stride, half, st->w[1], st->w[1], st->h[1]);
+        const uint8_t *half = (const uint8_t *)cells; /* free until the selection below */
+        if (image) home__refine_half_rows(ctx, image, stride, 0, st->h[1]);
         st->rk->blur3(half, st->w[1], st->pyr[1], st->w[1], st->w[1], st->h[1], row_tmp);
     }
     for (l = st->base_level + 1; l < st->levels; l++)
