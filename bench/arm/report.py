@@ -173,9 +173,42 @@ def mca_cycles(prog, vaddr, n, cpu):
     return result
 
 
+def block_end(prog, vaddr, n):
+    """The address after the block's n instructions (Thumb-2 mixes 2- and 4-byte ones)."""
+    dis = subprocess.run([ARCH[prog.arch]["tools"] + "objdump", "-d", "--no-show-raw-insn",
+                          "--start-address=0x%x" % vaddr, "--stop-address=0x%x" % (vaddr + 4 * n + 4),
+                          prog.path], capture_output=True, text=True, check=True).stdout
+    addrs = [int(m.group(1), 16) for m in re.finditer(r"^\s*([0-9a-f]+):\s+\S", dis, re.M)]
+    return addrs[n] if len(addrs) > n else vaddr + 4 * n
+
+
+def join_page_splits(prog, pf):
+    """qemu ends a translated block at a 4 KiB page boundary, so a loop that crosses one comes as
+    two blocks; given to llvm-mca apart, each would be scheduled as a loop of its own (the tail of
+    a loop body as a tight loop: far more cycles). A block that ends where a page starts is joined
+    with the page's first block for as many executions as it has (the page's block may also be
+    entered from elsewhere: those executions stay its own)."""
+    at_page = {v: n for (v, n), e in pf.items() if v % 4096 == 0 and e > 0}
+    if not at_page:
+        return pf
+    out = dict(pf)
+    for (u, m), e in pf.items():
+        page = (u // 4096 + 1) * 4096
+        n = at_page.get(page)
+        if e <= 0 or n is None or u % 4096 == 0 or u + 4 * m < page - 2 * m:
+            continue
+        tail_e = out.get((page, n), 0)
+        if tail_e + 1e-9 < e or block_end(prog, u, m) != page:
+            continue
+        del out[(u, m)]
+        out[(page, n)] = tail_e - e
+        out[(u, m + n)] = out.get((u, m + n), 0) + e
+    return out
+
+
 def analyse(out, arch, task, size, progs):
     prog = progs[(arch, TASKS[task][0])]
-    pf = per_frame(out, arch, task, size)
+    pf = join_page_splits(prog, per_frame(out, arch, task, size))
     stage_insns = collections.Counter()
     func_insns = collections.Counter()
     for (v, n), e in pf.items():
