@@ -40,6 +40,9 @@
                                 regions (or of the clearly decided ones) */
 #define TWO_MOTIONS_SHARE 0.1 /* ... and a motion is not ok when the identity clearly wins this
                                  share of the clearly decided regions */
+#define APART_SIGMAS 2.0     /* an uncertain photometric optimum this many predicted errors away
+                              * from HOME's estimate contradicts it (2, 3, 5 compared on the
+                              * tuning set: docs/trust.md) */
 #define IDENTITY_SIGMAS 2.0  /* a motion within this many predicted errors of the identity is it */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
@@ -88,7 +91,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     home__refine_state *st = &ctx->refine;
     home_result trial;
     int slot, vouches, agrees, has_estimate;
-    double t0 = home__now(ctx), radius, d, share, clear_share;
+    double t0 = home__now(ctx), radius, d, share, clear_share, apart;
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
     if (!st->levels) return;
@@ -102,7 +105,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     trial = *result;
     /* without an estimate of HOME's, direct alignment from the identity (small motion: dim,
      * faint or textureless frames give too few lines but may hold enough gradient) */
-    home__refine_run(ctx, slot, has_estimate ? result->H : home__refine_identity, &trial);
+    apart = home__refine_run(ctx, slot, has_estimate ? result->H : home__refine_identity, &trial);
     if (!has_estimate) {
         /* a local method vouches only within its reach: the identity is a start whose
          * uncertainty is the trust floor */
@@ -173,7 +176,11 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             memcpy(trial.H, home__refine_identity, sizeof trial.H);
             trial.model = HOME_MODEL_IDENTITY;
             trial.refine_status = HOME_REFINE_STATIC;
-        } else if (clear_share >= TWO_MOTIONS_SHARE) {
+        } else if (clear_share >= TWO_MOTIONS_SHARE ||
+                   (trial.refine_status == HOME_REFINE_ILL_CONDITIONED && apart > APART_SIGMAS)) {
+            /* ... or, HOME's estimate kept, the frame's own optimum (uncertain as it is) lies
+             * farther from it than both predicted errors allow (static fog with moving objects:
+             * HOME's lines 1-1.5 px off, the optimum 4-8 px away): neither can be vouched for */
             trial.ok = 0;
             trial.failure = HOME_FAIL_INCONSISTENT;
         }

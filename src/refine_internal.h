@@ -77,7 +77,10 @@ double home__refine_max_corner_distance(double cx, double cy, const double *h1,
                                         const double *h2);
 /* Refine h0 (A -> B pixels) with the template of slot `slot` against the stored pyramid:
  * the refined H and the refine fields of result. */
-void home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result);
+/* Returns, when it converged but the optimum is too uncertain to use (ILL_CONDITIONED), how far
+ * the optimum lies from h0 in units of both estimates' predicted errors (result->sigma_px on
+ * entry is h0's); else 0. */
+double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result);
 
 /* refine_static.c */
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,

@@ -526,7 +526,7 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
 
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid.
  * Writes the refined H and fills the refine fields of result. */
-void home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)
+double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
@@ -547,7 +547,7 @@ void home__refine_run(home_context *ctx, int slot, const double *h0, home_result
     home__refine_to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
     for (level = s.finest; level < st->levels; level++) {
-        if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return; }
+        if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return 0.0; }
     }
     for (level = st->levels - 1; level >= s.finest; level--) {
         double last_step = INFINITY;
@@ -557,7 +557,7 @@ void home__refine_run(home_context *ctx, int slot, const double *h0, home_result
             if (!iterate(&s, level, &step)) {
                 result->refine_iterations = iterations;
                 result->refine_status = HOME_REFINE_FEW_POINTS;
-                return;
+                return 0.0;
             }
             if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
             /* at the finest level, also a step far below the estimate's own predicted
@@ -575,21 +575,26 @@ void home__refine_run(home_context *ctx, int slot, const double *h0, home_result
         }
     }
     result->refine_iterations = iterations;
-    if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return; }
+    if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return 0.0; }
     to_pixels(&s, s.hn, h1);
     s.resid_var = residual_variance(&s);
     remove_noise_information(&s);
     refined_std = corner_std_px(&s);
     if (refined_std > max_std || !(s.split_px <= max_std)) {
+        /* how far the optimum lies from the start, in both estimates' predicted errors (the
+         * split-half spread where the Fisher one is undefined) */
+        const double own = isfinite(refined_std) ? refined_std : s.split_px;
+        const double spread = sqrt(own * own + result->sigma_px * result->sigma_px);
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
-        return;
+        return spread > 0.0 && isfinite(spread)
+                   ? home__refine_max_corner_distance(s.cx, s.cy, h1, h0) / spread : 0.0;
     }
     /* the same plausibility HOME's estimate passed: a refinement that slid towards a singular
      * H (a frame squeezed to a line keeps the photometric error low on flat content) is no
      * estimate (fuzz_api found one: tests/fuzz/corpus/api/regress-refined-singular-h) */
     if (!home__homography_plausible(h1, ctx->cfg.width, ctx->cfg.height)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
-        return;
+        return 0.0;
     }
     /* like for like: both estimates over the points both keep, at the scale of HOME's */
     {
@@ -618,13 +623,14 @@ void home__refine_run(home_context *ctx, int slot, const double *h0, home_result
     if (!(e1 < e0) &&
         !(home__refine_max_corner_distance(s.cx, s.cy, h1, h0) <= 3.0 * refined_std)) {
         result->refine_status = HOME_REFINE_NOT_LOWER;
-        return;
+        return 0.0;
     }
     if (!choose_model(&s, ctx->cfg.max_model, h1, result)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
-        return;
+        return 0.0;
     }
     memcpy(result->H, h1, sizeof h1);
     result->refined = 1;
     result->refine_status = HOME_REFINE_ACCEPTED;
+    return 0.0;
 }
