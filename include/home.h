@@ -294,7 +294,9 @@ typedef struct home_result {
  * 8x6 grid explain worse than the identity does (each region votes with its own strongest
  * points, so textured moving objects cannot outvote a plainer background), becomes the
  * identity (HOME_REFINE_STATIC). One the identity clearly explains better in a tenth of the
- * clearly decided regions is two motions, not ok (HOME_FAIL_INCONSISTENT). */
+ * clearly decided regions is two motions, not ok (HOME_FAIL_INCONSISTENT); so is HOME's kept
+ * estimate when the refinement converged ill-conditioned more than 2 predicted errors (both
+ * estimates') away from it. */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 
