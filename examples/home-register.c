@@ -38,6 +38,10 @@ static void usage(FILE *f)
         "  --sigma BINS         Gaussian smoothing of the Hough image (default 1.3)\n"
         "  --hough-downscale N  1: Hough transform of the full image (default); 2 or 4: of a\n"
         "                       2x2- or 4x4-box downscaled copy (4x or 16x less Hough work)\n"
+        "  --fast-pass N        0: one pass; 2 or 4: first a fast pass (Hough of a 2x2- or\n"
+        "                       4x4-box downscaled copy, half the theta bins and keypoints),\n"
+        "                       the full one only when it is not ok (default 0; ignored with\n"
+        "                       --save-hough); \"fast_pass\" says which answered\n"
         "  --theta-window N     motion prior: match only keypoints within N theta bins of each\n"
         "                       other (0 = off, the default; --video: 8 of 120 bins = 12 degrees)\n"
         "  --ratio R            Lowe ratio test (default 0.9)\n"
@@ -148,7 +152,7 @@ int main(int argc, char **argv)
     const char *paths[2] = {NULL, NULL}, *hough_path = NULL;
     home_config cfg;
     int n_paths = 0, i, repeat = 1, status, s, video = 0, exact = 0;
-    int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_rpoints = -1, opt_downscale = -1,
+    int opt_kp = -1, opt_theta = -1, opt_min_in = -1, opt_rlevels = -1, opt_riters = -1, opt_rpoints = -1, opt_downscale = -1, opt_fast = -1,
         opt_window = -1, opt_rfinest = -1, opt_max_model = -1;
     float opt_rtrust = -1, opt_max_sigma = -1;
     float opt_ratio = -1, opt_thr = -1, opt_thr0 = -1, opt_rstep = -1, opt_sigma = -1;
@@ -194,6 +198,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--r-step")) bad = parse_float(v, &opt_rstep), i++;
         else if (!strcmp(a, "--sigma")) bad = parse_float(v, &opt_sigma), i++;
         else if (!strcmp(a, "--hough-downscale")) bad = parse_int(v, &opt_downscale), i++;
+        else if (!strcmp(a, "--fast-pass")) bad = parse_int(v, &opt_fast), i++;
         else if (!strcmp(a, "--theta-window")) bad = parse_int(v, &opt_window), i++;
         else if (!strcmp(a, "--save-hough")) hough_path = v, i++;
         else if (!strncmp(a, "--", 2)) { fprintf(stderr, "home-register: unknown option %s\n", a); usage(stderr); return 2; }
@@ -226,6 +231,8 @@ int main(int argc, char **argv)
     if (opt_sigma >= 0) cfg.smooth_sigma = opt_sigma;
     if (opt_downscale >= 0) cfg.hough_downscale = opt_downscale;
     if (opt_window >= 0) cfg.match_theta_window = opt_window;
+    if (opt_fast >= 0) cfg.fast_pass_downscale = opt_fast;
+    if (hough_path) cfg.fast_pass_downscale = 0; /* the saved keypoints are the full pass's */
     if (opt_rlevels >= 0) cfg.refine_levels = opt_rlevels;
     if (opt_riters >= 0) cfg.refine_iterations = opt_riters;
     if (opt_rpoints >= 0) cfg.refine_points = opt_rpoints;
@@ -293,8 +300,9 @@ int main(int argc, char **argv)
     printf(",\"model\":\"%s\",\"sigma_px\":", home_model_name(res.model));
     if (isfinite(res.sigma_px)) printf("%.*g", exact ? 17 : 6, res.sigma_px);
     else printf("null"); /* not determined: JSON has no infinity */
-    printf(",\"failure\":\"%s\",\"refine_status\":\"%s\"", home_failure_name(res.failure),
-           home_refine_status_name(res.refine_status));
+    printf(",\"failure\":\"%s\",\"refine_status\":\"%s\",\"fast_pass\":%s",
+           home_failure_name(res.failure), home_refine_status_name(res.refine_status),
+           res.fast_pass ? "true" : "false");
     if (exact) { /* every digit, no timings: byte-comparable output (tests/checks/golden.sh) */
         printf(",\"refine_zncc\":%.17g,\"refine_inlier_share\":%.17g}\n", res.refine_zncc,
                res.refine_inlier_share);

@@ -35,6 +35,22 @@ static void plan(const home_config *cfg, layout *l)
     l->total = home__align_up(cur, HOME__BLOCK_ALIGN);
 }
 
+/* A pass's sizes from its configuration (its strides and geometry come with the Hough block) */
+static void pass_from(const home_config *cfg, home__pass *p)
+{
+    memset(p, 0, sizeof *p);
+    p->cfg = *cfg;
+    p->r_bins = home__r_bins(cfg);
+    home__hough_size(cfg, &p->hough_w, &p->hough_h);
+    p->hough_scale = cfg->hough_downscale;
+    /* the Hough image covers full-image columns [0, scale * hough_w): its centre sits at
+     * (scale * hough_w - 1) / 2, i.e. this far from the full image's centre */
+    p->hough_dx = 0.5 * (p->hough_scale * p->hough_w - cfg->width);
+    p->hough_dy = 0.5 * (p->hough_scale * p->hough_h - cfg->height);
+    p->cfg.r_bins = p->r_bins;
+    p->config_id = home__config_id(&p->cfg);
+}
+
 size_t home_arena_size(const home_config *cfg)
 {
     layout l;
@@ -62,16 +78,16 @@ int home_init(home_context **out, const home_config *cfg, void *arena, size_t ar
 
     ctx = (home_context *)(void *)(base + l.ctx);
     memset(ctx, 0, sizeof *ctx);
-    ctx->cfg = *cfg;
-    ctx->r_bins = home__r_bins(cfg);
-    home__hough_size(cfg, &ctx->hough_w, &ctx->hough_h);
-    ctx->hough_scale = cfg->hough_downscale;
-    /* the Hough image covers full-image columns [0, scale * hough_w): its centre sits at
-     * (scale * hough_w - 1) / 2, i.e. this far from the full image's centre */
-    ctx->hough_dx = 0.5 * (ctx->hough_scale * ctx->hough_w - cfg->width);
-    ctx->hough_dy = 0.5 * (ctx->hough_scale * ctx->hough_h - cfg->height);
-    ctx->cfg.r_bins = ctx->r_bins;
-    ctx->config_id = home__config_id(&ctx->cfg);
+    pass_from(cfg, &ctx->passes[0]);
+    ctx->n_passes = 1;
+    {
+        home_config fast;
+        if (home__fast_pass_config(cfg, &fast)) {
+            pass_from(&fast, &ctx->passes[1]);
+            ctx->n_passes = 2;
+        }
+    }
+    home__select_pass(ctx, 0);
     ctx->kernels = home__kernels_for(cfg->simd);
     home__hough_init(ctx, base + l.hough);
     ctx->heap_items = (home__candidate *)(void *)(base + l.heap);

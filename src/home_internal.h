@@ -89,6 +89,19 @@ typedef struct home__theta_geom {
     float *res_f;                     /*   f of line[k] + f (line[k+1] - line[k]) */
 } home__theta_geom;
 
+/* One Hough set-up of the context: the configured one, and home_register()'s fast pass
+ * (cfg.fast_pass_downscale). The stages read the context's live copies of these fields;
+ * home__select_pass() switches them. */
+typedef struct home__pass {
+    home_config cfg;                  /* the context's configuration with this pass's Hough
+                                         settings */
+    uint32_t config_id;
+    int r_bins, hough_w, hough_h, hough_scale;
+    double hough_dx, hough_dy;
+    ptrdiff_t img_n_stride, img_t_stride;
+    home__theta_geom *geom;           /* FAST: its theta rows' geometry, or NULL */
+} home__pass;
+
 struct home_context {
     uint32_t magic;
     home_config cfg;
@@ -129,6 +142,8 @@ struct home_context {
     float *window_theta;              /*   their theta */
     int *window_index;                /*   their index in b */
     int slots_valid;
+    home__pass passes[2];             /* 0: the configured pass; 1: the fast pass, if any */
+    int n_passes;
     home__refine_state refine;
 };
 
@@ -154,6 +169,9 @@ static inline int home__finite_in(double v, double lo, double hi)
 
 /* config.c */
 uint32_t home__config_id(const home_config *cfg);
+/* home_register()'s fast pass for cfg (a valid configuration): 1 and its configuration in
+ * *fast, or 0 when it has none. */
+int home__fast_pass_config(const home_config *cfg, home_config *fast);
 int home__r_bins(const home_config *cfg);
 void home__hough_size(const home_config *cfg, int *width, int *height);
 
@@ -183,6 +201,8 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
  * context's sizes, cfg and r_bins, already set). */
 size_t home__hough_bytes(const home_config *cfg);
 void home__hough_init(home_context *ctx, unsigned char *block);
+/* Make pass k (0 configured, 1 fast) the one the stages see. */
+void home__select_pass(home_context *ctx, int k);
 /* Rows [y0, y1) of the image the Hough transform sees (box-downscaled when hough_downscale > 1)
  * from image; FAST only. */
 void home__hough_load_rows(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int y0,

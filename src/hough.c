@@ -428,11 +428,55 @@ static void hough_plan(const home_config *cfg, hough_layout *l)
     l->total = home__align_up(cur, HOME__BLOCK_ALIGN);
 }
 
+void home__select_pass(home_context *ctx, int k)
+{
+    const home__pass *p = &ctx->passes[k];
+    ctx->cfg = p->cfg;
+    ctx->config_id = p->config_id;
+    ctx->r_bins = p->r_bins;
+    ctx->hough_w = p->hough_w;
+    ctx->hough_h = p->hough_h;
+    ctx->hough_scale = p->hough_scale;
+    ctx->hough_dx = p->hough_dx;
+    ctx->hough_dy = p->hough_dy;
+    ctx->img_n_stride = p->img_n_stride;
+    ctx->img_t_stride = p->img_t_stride;
+    ctx->geom = p->geom;
+}
+
+/* Bytes of a pass's cached theta geometry (0: none, rows computed one at a time) */
+static size_t geom_table_bytes(const hough_layout *l)
+{
+    return l->geom_rows ? home__align_up((size_t)l->geom_rows * sizeof(home__theta_geom), 16) +
+                              (size_t)l->geom_rows * l->geom_bytes
+                        : 0;
+}
+
+/* The buffers are the configured pass's; a fast pass (smaller in every dimension) shares them
+ * and adds only its own cached geometry, after them. */
 size_t home__hough_bytes(const home_config *cfg)
 {
-    hough_layout l;
+    hough_layout l, f;
+    home_config fast;
     hough_plan(cfg, &l);
-    return l.total;
+    if (!home__fast_pass_config(cfg, &fast)) return l.total;
+    hough_plan(&fast, &f);
+    return home__align_up(l.total + geom_table_bytes(&f), HOME__BLOCK_ALIGN);
+}
+
+/* The live pass's theta geometry: the records at table, then their arrays (l's sizes) */
+static void fill_geometry(home_context *ctx, unsigned char *table, const hough_layout *l)
+{
+    unsigned char *arrays =
+        table + home__align_up((size_t)l->geom_rows * sizeof(home__theta_geom), 16);
+    int k;
+    ctx->geom = (home__theta_geom *)(void *)table;
+    for (k = 0; k < l->geom_rows; k++) {
+        carve_geom(&ctx->geom[k], arrays + (size_t)k * l->geom_bytes, l->geom_longest,
+                   l->geom_blocks, l->geom_intercepts, (size_t)ctx->r_bins);
+        home__theta_geometry(ctx, (l->geom_first + k) * HOME__PI / ctx->cfg.theta_bins,
+                             &ctx->geom[k]);
+    }
 }
 
 void home__hough_init(home_context *ctx, unsigned char *block)
@@ -451,16 +495,7 @@ void home__hough_init(home_context *ctx, unsigned char *block)
         ctx->img_t_stride = l.img_t_stride;
         if (l.geom_rows) {
             /* records first, then their arrays; every row's geometry computed once, here */
-            unsigned char *arrays =
-                block + l.geom + home__align_up((size_t)l.geom_rows * sizeof(home__theta_geom), 16);
-            int k;
-            ctx->geom = (home__theta_geom *)(void *)(block + l.geom);
-            for (k = 0; k < l.geom_rows; k++) {
-                carve_geom(&ctx->geom[k], arrays + (size_t)k * l.geom_bytes, l.geom_longest,
-                           l.geom_blocks, l.geom_intercepts, (size_t)ctx->r_bins);
-                home__theta_geometry(ctx, (l.geom_first + k) * HOME__PI / cfg->theta_bins,
-                                     &ctx->geom[k]);
-            }
+            fill_geometry(ctx, block + l.geom, &l);
         } else {
             ctx->geom = NULL;
             carve_geom(&ctx->geom_scratch, block + l.geom_scratch, l.geom_longest, l.geom_blocks,
@@ -475,4 +510,22 @@ void home__hough_init(home_context *ctx, unsigned char *block)
     ctx->raw_rows = (float *)(void *)(block + l.raw_rows);
     ctx->smooth_rows = (float *)(void *)(block + l.smooth_rows);
     ctx->row_tmp = (float *)(void *)(block + l.row_tmp);
+    ctx->passes[0].img_n_stride = ctx->img_n_stride;
+    ctx->passes[0].img_t_stride = ctx->img_t_stride;
+    ctx->passes[0].geom = ctx->geom;
+    if (ctx->n_passes > 1) {
+        /* the fast pass: its strides in the shared buffers, its own geometry after them (or
+         * the shared scratch record, which the configured pass's larger sizes carved) */
+        hough_layout f;
+        hough_plan(&ctx->passes[1].cfg, &f);
+        ctx->passes[1].img_n_stride = f.img_n_stride;
+        ctx->passes[1].img_t_stride = f.img_t_stride;
+        ctx->passes[1].geom = NULL;
+        home__select_pass(ctx, 1);
+        if (f.geom_rows) {
+            fill_geometry(ctx, block + l.total, &f);
+            ctx->passes[1].geom = ctx->geom;
+        }
+        home__select_pass(ctx, 0);
+    }
 }

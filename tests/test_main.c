@@ -11,7 +11,7 @@
 #define TEST_LIST(X) \
     X(config_defaults) X(arena_layout) X(hough_geometry_cache) X(heap_keeps_top_k) X(hough_edge_extremum) \
     X(hough_wrap_symmetry) X(descriptor_invariance) X(homography_plausible) X(lm_exact_lines) X(halving_with_outliers) X(theta_window_prior) \
-    X(end_to_end_structured) X(end_to_end_weak_texture) X(downscaled_hough) X(video_config) X(video_reuse_matches_pair) \
+    X(end_to_end_structured) X(end_to_end_weak_texture) X(downscaled_hough) X(video_config) X(fast_pass) X(video_reuse_matches_pair) \
     X(deterministic_output) X(fails_cleanly) X(bad_inputs) X(kernels_radon) X(kernels_line_ends) X(kernels_resample) X(kernels_nearest) \
     X(kernels_smooth) X(kernels_box_down) X(kernels_extremum_candidates) X(refine_kernels_backends) \
     X(warp_backends_identical) X(warp_plane_end) X(backends_identical_output) X(fast_hough_matches_exact) \

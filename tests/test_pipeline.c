@@ -140,6 +140,59 @@ void test_video_config(void)
 
 void test_end_to_end_weak_texture(void) { end_to_end(SYNTH_WEAK_TEXTURE, 2000); }
 
+void test_fast_pass(void)
+{
+    /* home_register()'s fast pass answers a structured pair as precisely as the full pass; its
+     * features cannot be mixed with home_extract()'s; and when it is not ok (here: noise
+     * against other noise), the answer is the one-pass answer bit for bit */
+    home_config cfg, one;
+    home_context *ctx;
+    home_result fast, full, res;
+    double h[9];
+    synth_rng rng;
+    size_t i;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    CHECK_EQ_INT(cfg.fast_pass_downscale, 0);
+    cfg.fast_pass_downscale = 4;
+    render_pair(SYNTH_STRUCTURED, 61, 20, h);
+    ctx = test_context(IMG_W, IMG_H, &cfg);
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &fast), HOME_OK);
+    CHECK(fast.ok && fast.fast_pass && fast.refined);
+    CHECK(synth_corner_error(fast.H, h, IMG_W, IMG_H) < 0.15);
+    CHECK(home_last_features(ctx, 0) != NULL);
+    CHECK_EQ_INT(home_extract(ctx, img_b, IMG_W, &fb), HOME_OK);
+    CHECK_EQ_INT(home_match(ctx, home_last_features(ctx, 0), &fb, &res), HOME_E_MISMATCH);
+
+    one = cfg;
+    one.fast_pass_downscale = 0;
+    ctx = test_context(IMG_W, IMG_H, &one);
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &full), HOME_OK);
+    CHECK(full.ok && !full.fast_pass);
+    CHECK(fabs(synth_corner_error(fast.H, h, IMG_W, IMG_H) -
+               synth_corner_error(full.H, h, IMG_W, IMG_H)) < 0.05);
+
+    synth_seed(&rng, 5);
+    for (i = 0; i < sizeof img_a; i++) {
+        img_a[i] = (uint8_t)(synth_uniform(&rng) * 256);
+        img_b[i] = (uint8_t)(synth_uniform(&rng) * 256);
+    }
+    ctx = test_context(IMG_W, IMG_H, &one);
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &full), HOME_OK);
+    ctx = test_context(IMG_W, IMG_H, &cfg);
+    if (!ctx) { CHECK(0); return; }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+    CHECK(!res.fast_pass);
+    CHECK_EQ_INT(res.ok, full.ok);
+    CHECK_EQ_INT(res.failure, full.failure);
+    CHECK_EQ_INT(res.refine_status, full.refine_status);
+    CHECK(memcmp(res.H, full.H, sizeof res.H) == 0);
+    CHECK_EQ_INT(res.inliers, full.inliers);
+    CHECK_EQ_INT(res.matches, full.matches);
+}
+
 void test_video_reuse_matches_pair(void)
 {
     /* registering cached features gives exactly what the two-image call gives */

@@ -186,7 +186,11 @@ static void fuzz_config(fz_reader *r, home_config *cfg)
         case 12: cfg->refine_trust_px = f; break;
         case 13: cfg->simd = raw % 8; break;
         case 14: cfg->hough_method = raw % 4; break;
-        case 15: cfg->hough_downscale = raw % 6; break; /* 1, 2, 4 valid */
+        case 15: /* 1, 2, 4 valid; the fast pass's 0, 2, 4 from the same bytes (the corpus's
+                  * entries keep their meaning) */
+            cfg->hough_downscale = raw % 6;
+            cfg->fast_pass_downscale = (int)((uint32_t)raw / 6 % 6);
+            break;
         case 16: cfg->match_theta_window = raw % 4096; break;
         case 17: cfg->refine_points = raw % 8192; break;
         case 18: cfg->refine_finest_level = raw % 4; break;
@@ -336,7 +340,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     check_features(&cfg, home_last_features(ctx, 0));
     check_features(&cfg, home_last_features(ctx, 1));
 
-    if (flags & FLAG_VIDEO) {
+    FZ_CHECK(res.fast_pass == 0 || res.fast_pass == 1);
+    FZ_CHECK(!res.fast_pass || res.ok);
+    if (res.fast_pass) {
+        /* the fast pass's features are its own: refused beside the configured pass's */
+        FZ_CHECK(home_extract(ctx, img_a, stride_a, &fa) == HOME_OK);
+        FZ_CHECK(home_extract(ctx, img_b, stride_b, &fb) == HOME_OK);
+        FZ_CHECK(home_match(ctx, home_last_features(ctx, 0), &fb, &res2) == HOME_E_MISMATCH);
+    } else if (flags & FLAG_VIDEO) {
         /* the video path (and so a re-extraction) reproduces the pair path bit for bit */
         FZ_CHECK(home_extract(ctx, img_a, stride_a, &fa) == HOME_OK);
         FZ_CHECK(home_extract(ctx, img_b, stride_b, &fb) == HOME_OK);
