@@ -9,7 +9,8 @@
 //   Head to head: the ORB frame and the HOME video frames (home_video_config, and the same
 //     with the refinement ending at full size; the automatic backend) timed in rotation, 5x
 //     runs of each, so load on a shared machine hits all alike; then the still-pair protocol:
-//     ORB on both images + matching + homography against home_register() with the defaults.
+//     ORB on both images + matching + homography against home_register() with the defaults
+//     and with the fast pass.
 // Prints a table and the ratios; usage: home-bench [runs]
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -49,15 +50,17 @@ struct HomeContext {
 
 // preset 0: defaults with refinement; 1: defaults without; 2: home_video_config (Hough of a
 // ~160 px wide box-downscaled frame, 120 theta bins, theta window, refinement ending at half
-// size); 3: the video preset with the refinement ending at full size (refine_finest_level 0)
-static const char *preset_name[] = {"default", "no-refine", "video", "video-full"};
-enum { N_PRESETS = 4 };
+// size); 3: the video preset with the refinement ending at full size (refine_finest_level 0);
+// 4: the defaults with home_register()'s fast pass (fast_pass_downscale 4)
+static const char *preset_name[] = {"default", "no-refine", "video", "video-full", "fast-pass"};
+enum { N_PRESETS = 5 };
 
 static void preset_config(int preset, int w, int h, home_config &cfg) {
-    if (preset >= 2) home_video_config(&cfg, w, h);
+    if (preset == 2 || preset == 3) home_video_config(&cfg, w, h);
     else home_default_config(&cfg, w, h);
     if (preset == 1) cfg.refine_levels = 0;
     if (preset == 3) cfg.refine_finest_level = 0;
+    if (preset == 4) cfg.fast_pass_downscale = 4;
 }
 
 static bool time_home(int simd, int preset, int w, int h, const std::vector<uint8_t> &a,
@@ -175,28 +178,34 @@ static bool head_to_head(int w, int h, const std::vector<uint8_t> &a, const std:
 }
 
 // The still-pair protocol in rotation, runs times each: ORB on both images + matching +
-// homography, and home_register() with the defaults (the automatic backend); medians.
+// homography, and home_register() with the defaults and with the fast pass (the automatic
+// backend); medians.
 static bool pair_head_to_head(int w, int h, const std::vector<uint8_t> &a,
                               const std::vector<uint8_t> &b, int runs, double &orb_ms,
-                              double &home_ms) {
+                              double *home_ms) {
     cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data());
     OrbPipeline orb(ma);
-    home_config cfg;
-    preset_config(0, w, h, cfg);
-    HomeContext home(cfg);
-    if (!home.ctx) return false;
+    home_config cfg[2];
+    preset_config(0, w, h, cfg[0]);
+    preset_config(4, w, h, cfg[1]);
+    HomeContext home0(cfg[0]), home1(cfg[1]);
+    HomeContext *home[2] = {&home0, &home1};
+    if (!home0.ctx || !home1.ctx) return false;
     home_result res;
-    std::vector<double> t_orb, t_home;
+    std::vector<double> t_orb, t_home[2];
     for (int i = 0; i < runs; i++) {
         double t0 = now_ms(nullptr);
         orb.pair(ma, mb);
         t_orb.push_back(now_ms(nullptr) - t0);
-        t0 = now_ms(nullptr);
-        home_register(home.ctx, a.data(), w, b.data(), w, &res);
-        t_home.push_back(now_ms(nullptr) - t0);
+        for (int k = 0; k < 2; k++) {
+            t0 = now_ms(nullptr);
+            home_register(home[k]->ctx, a.data(), w, b.data(), w, &res);
+            t_home[k].push_back(now_ms(nullptr) - t0);
+        }
     }
     orb_ms = median(t_orb);
-    home_ms = median(t_home);
+    home_ms[0] = median(t_home[0]);
+    home_ms[1] = median(t_home[1]);
     return true;
 }
 
@@ -298,11 +307,13 @@ int main(int argc, char **argv) {
                    "%.2f ms, ORB/HOME %.2f; video-full frame %.2f ms, ORB/HOME %.2f\n",
                    5 * runs, backend, h2h_orb, h2h_home[0], h2h_orb / h2h_home[0], h2h_home[1],
                    h2h_orb / h2h_home[1]);
-        double pair_orb, pair_home;
+        double pair_orb, pair_home[2];
         if (pair_head_to_head(w, h, a, b, 5 * runs, pair_orb, pair_home))
             printf("still pairs head to head (in rotation, %d runs each): ORB pair %.2f ms; HOME "
-                   "defaults pair %.2f ms, HOME/ORB %.2f\n",
-                   5 * runs, pair_orb, pair_home, pair_home / pair_orb);
+                   "defaults pair %.2f ms, HOME/ORB %.2f; with the fast pass %.2f ms, HOME/ORB "
+                   "%.2f\n",
+                   5 * runs, pair_orb, pair_home[0], pair_home[0] / pair_orb, pair_home[1],
+                   pair_home[1] / pair_orb);
         printf("\n");
     }
     return 0;
