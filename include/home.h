@@ -132,7 +132,7 @@ typedef struct home_config {
                                  pass only when the fast one's answer is not ok; 0 = one pass.
                                  Runs with the FAST transform and the refinement, when this
                                  exceeds hough_downscale (else one pass). Default 0: 4 at
-                                 640x360 took 0.15x the time at the same errors on the
+                                 640x360 took 0.13-0.25x the time at the same errors on the
                                  evaluation's tuning set, but let wrong answers through on its
                                  test set (repeated patterns; docs/speed.md) */
     home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */

@@ -78,9 +78,9 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->match_theta_window = 0;
     cfg->max_model = HOME_MODEL_HOMOGRAPHY;
     cfg->max_sigma_px = 1.0f;
-    /* one pass: the fast pass (4 at 640x360) registers a pair it answers in ~0.15 of the time
-     * at the same errors on the evaluation's tuning set, but on its test set it answered
-     * repeated patterns 76-92 px off as ok (docs/speed.md) */
+    /* one pass: the fast pass (4 at 640x360) took 0.13-0.25x the time at the same errors on the
+     * evaluation's tuning set, but on its test set it answered repeated patterns 76-92 px off
+     * as ok (docs/speed.md) */
     cfg->fast_pass_downscale = 0;
     if (width < HOME_MIN_SIDE || height < HOME_MIN_SIDE || width > HOME_MAX_SIDE ||
         height > HOME_MAX_SIDE)
