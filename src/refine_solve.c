@@ -547,7 +547,10 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, home_resu
     home__refine_to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
     for (level = s.finest; level < st->levels; level++) {
-        if (s.tpl[level].n < MIN_POINTS) { result->refine_status = HOME_REFINE_FEW_POINTS; return 0.0; }
+        if (s.tpl[level].n < MIN_POINTS) {
+            result->refine_status = HOME_REFINE_FEW_POINTS;
+            return 0.0;
+        }
     }
     for (level = st->levels - 1; level >= s.finest; level--) {
         double last_step = INFINITY;
