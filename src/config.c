@@ -134,9 +134,9 @@ int home__r_bins(const home_config *cfg)
     return cfg->r_bins ? cfg->r_bins : r_bins_for(w, h, cfg->r_step);
 }
 
-int home_validate_config(const home_config *cfg)
+/* Everything but the fast pass (validated as a configuration of its own, with this) */
+static int validate_pass(const home_config *cfg)
 {
-    if (!cfg) return HOME_E_NULL;
     if (cfg->width < HOME_MIN_SIDE || cfg->height < HOME_MIN_SIDE ||
         cfg->width > HOME_MAX_SIDE || cfg->height > HOME_MAX_SIDE)
         return HOME_E_SIZE;
@@ -178,12 +178,20 @@ int home_validate_config(const home_config *cfg)
     if (cfg->max_model < HOME_MODEL_IDENTITY || cfg->max_model > HOME_MODEL_HOMOGRAPHY)
         return HOME_E_CONFIG;
     if (!home__finite_in(cfg->max_sigma_px, 0.02f, 100.0f)) return HOME_E_CONFIG;
-    if (cfg->fast_pass_downscale != 0) {
-        home_config fast;
-        if (cfg->fast_pass_downscale != 2 && cfg->fast_pass_downscale != 4) return HOME_E_CONFIG;
-        if (home__fast_pass_config(cfg, &fast) && home_validate_config(&fast) != HOME_OK)
-            return HOME_E_CONFIG;
-    }
+    return HOME_OK;
+}
+
+int home_validate_config(const home_config *cfg)
+{
+    home_config fast;
+    int status;
+    if (!cfg) return HOME_E_NULL;
+    if ((status = validate_pass(cfg)) != HOME_OK) return status;
+    if (cfg->fast_pass_downscale != 0 && cfg->fast_pass_downscale != 2 &&
+        cfg->fast_pass_downscale != 4)
+        return HOME_E_CONFIG;
+    if (home__fast_pass_config(cfg, &fast) && validate_pass(&fast) != HOME_OK)
+        return HOME_E_CONFIG;
     return HOME_OK;
 }
 
