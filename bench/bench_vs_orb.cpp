@@ -142,15 +142,17 @@ static double time_orb(int w, int h, const std::vector<uint8_t> &a, const std::v
     return median(t);
 }
 
-// The ORB frame and HOME's two video frames (presets 2 and 3) in rotation, runs times each:
-// medians of all three.
+// ORB and two HOME presets in rotation, runs times each, medians (the automatic backend).
+// pair: the still-pair protocol (ORB on both images + matching + homography, home_register());
+// else one new frame against the previous one's cached features (home_extract + home_match).
 static bool head_to_head(int w, int h, const std::vector<uint8_t> &a, const std::vector<uint8_t> &b,
-                         int runs, double &orb_ms, double *home_ms, const char **backend) {
+                         int runs, const int *presets, bool pair, double &orb_ms, double *home_ms,
+                         const char **backend) {
     cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data());
     OrbPipeline orb(ma);
     home_config cfg[2];
-    preset_config(2, w, h, cfg[0]);
-    preset_config(3, w, h, cfg[1]);
+    preset_config(presets[0], w, h, cfg[0]);
+    preset_config(presets[1], w, h, cfg[1]);
     HomeContext home0(cfg[0]), home1(cfg[1]);
     HomeContext *home[2] = {&home0, &home1};
     if (!home0.ctx || !home1.ctx) return false;
@@ -160,46 +162,20 @@ static bool head_to_head(int w, int h, const std::vector<uint8_t> &a, const std:
     std::vector<double> t_orb, t_home[2];
     for (int i = 0; i < runs; i++) {
         double t0 = now_ms(nullptr);
-        orb.frame(mb);
+        if (pair) orb.pair(ma, mb);
+        else orb.frame(mb);
         t_orb.push_back(now_ms(nullptr) - t0);
         for (int k = 0; k < 2; k++) {
             home_context *ctx = home[k]->ctx;
-            home_extract(ctx, a.data(), w, &fa);  // the previous frame, cached (not timed)
-            t0 = now_ms(nullptr);
-            home_extract(ctx, b.data(), w, &fb);
-            home_match(ctx, &fa, &fb, &res);
-            t_home[k].push_back(now_ms(nullptr) - t0);
-        }
-    }
-    orb_ms = median(t_orb);
-    home_ms[0] = median(t_home[0]);
-    home_ms[1] = median(t_home[1]);
-    return true;
-}
-
-// The still-pair protocol in rotation, runs times each: ORB on both images + matching +
-// homography, and home_register() with the defaults and with the fast pass (the automatic
-// backend); medians.
-static bool pair_head_to_head(int w, int h, const std::vector<uint8_t> &a,
-                              const std::vector<uint8_t> &b, int runs, double &orb_ms,
-                              double *home_ms) {
-    cv::Mat ma(h, w, CV_8UC1, (void *)a.data()), mb(h, w, CV_8UC1, (void *)b.data());
-    OrbPipeline orb(ma);
-    home_config cfg[2];
-    preset_config(0, w, h, cfg[0]);
-    preset_config(4, w, h, cfg[1]);
-    HomeContext home0(cfg[0]), home1(cfg[1]);
-    HomeContext *home[2] = {&home0, &home1};
-    if (!home0.ctx || !home1.ctx) return false;
-    home_result res;
-    std::vector<double> t_orb, t_home[2];
-    for (int i = 0; i < runs; i++) {
-        double t0 = now_ms(nullptr);
-        orb.pair(ma, mb);
-        t_orb.push_back(now_ms(nullptr) - t0);
-        for (int k = 0; k < 2; k++) {
-            t0 = now_ms(nullptr);
-            home_register(home[k]->ctx, a.data(), w, b.data(), w, &res);
+            if (pair) {
+                t0 = now_ms(nullptr);
+                home_register(ctx, a.data(), w, b.data(), w, &res);
+            } else {
+                home_extract(ctx, a.data(), w, &fa);  // the previous frame, cached (not timed)
+                t0 = now_ms(nullptr);
+                home_extract(ctx, b.data(), w, &fb);
+                home_match(ctx, &fa, &fb, &res);
+            }
             t_home[k].push_back(now_ms(nullptr) - t0);
         }
     }
@@ -302,13 +278,14 @@ int main(int argc, char **argv) {
             }
         double h2h_orb, h2h_home[2];
         const char *backend = "";
-        if (head_to_head(w, h, a, b, 5 * runs, h2h_orb, h2h_home, &backend))
+        static const int video_presets[2] = {2, 3}, pair_presets[2] = {0, 4};
+        if (head_to_head(w, h, a, b, 5 * runs, video_presets, false, h2h_orb, h2h_home, &backend))
             printf("head to head (in rotation, %d runs each, %s): ORB frame %.2f ms; HOME video frame "
                    "%.2f ms, ORB/HOME %.2f; video-full frame %.2f ms, ORB/HOME %.2f\n",
                    5 * runs, backend, h2h_orb, h2h_home[0], h2h_orb / h2h_home[0], h2h_home[1],
                    h2h_orb / h2h_home[1]);
         double pair_orb, pair_home[2];
-        if (pair_head_to_head(w, h, a, b, 5 * runs, pair_orb, pair_home))
+        if (head_to_head(w, h, a, b, 5 * runs, pair_presets, true, pair_orb, pair_home, &backend))
             printf("still pairs head to head (in rotation, %d runs each): ORB pair %.2f ms; HOME "
                    "defaults pair %.2f ms, HOME/ORB %.2f; with the fast pass %.2f ms, HOME/ORB "
                    "%.2f\n",

@@ -270,19 +270,25 @@ void test_gst_timestamps_preserved(void)
     gst_harness_teardown(hh);
 }
 
-/* Run n frames of the shaky scene (or the still frame) through homestab; outputs into bufs. */
-static int run_clip(const char *format, const char *props_margin, int still, int n, GstBuffer **bufs)
+/* End the stream and take its n outputs into bufs; the harness is gone after. */
+static int drain(GstHarness *hh, GstBuffer **bufs, int n)
 {
-    GstHarness *hh = harness(format, W, H);
     int got;
-    g_object_set(hh->element, "lookahead", 4, NULL);
-    if (props_margin) g_object_set(hh->element, "margin", (gfloat)g_ascii_strtod(props_margin, NULL), NULL);
-    CHECK_EQ_INT(push_frames(hh, format, W, H, still ? -1 : 0, n), GST_FLOW_OK);
     CHECK(gst_harness_push_event(hh, gst_event_new_eos()));
     got = pull_all(hh, bufs, n);
     CHECK_EQ_INT(got, n);
     gst_harness_teardown(hh);
     return got;
+}
+
+/* Run n frames of the shaky scene (or the still frame) through homestab; outputs into bufs. */
+static int run_clip(const char *format, const char *props_margin, int still, int n, GstBuffer **bufs)
+{
+    GstHarness *hh = harness(format, W, H);
+    g_object_set(hh->element, "lookahead", 4, NULL);
+    if (props_margin) g_object_set(hh->element, "margin", (gfloat)g_ascii_strtod(props_margin, NULL), NULL);
+    CHECK_EQ_INT(push_frames(hh, format, W, H, still ? -1 : 0, n), GST_FLOW_OK);
+    return drain(hh, bufs, n);
 }
 
 /* A still camera with no margin: the warp is the identity, every byte of every plane passes. */
@@ -522,16 +528,11 @@ void test_gst_pooled_input_copied(void)
 static int run_clip_threads(const char *format, int threads, int later, int n, GstBuffer **bufs)
 {
     GstHarness *hh = harness(format, W, H);
-    int got;
     g_object_set(hh->element, "lookahead", 4, "threads", threads, NULL);
     CHECK_EQ_INT(push_frames(hh, format, W, H, 0, n / 2), GST_FLOW_OK);
     g_object_set(hh->element, "threads", later, NULL);
     CHECK_EQ_INT(push_frames(hh, format, W, H, n / 2, n - n / 2), GST_FLOW_OK);
-    CHECK(gst_harness_push_event(hh, gst_event_new_eos()));
-    got = pull_all(hh, bufs, n);
-    CHECK_EQ_INT(got, n);
-    gst_harness_teardown(hh);
-    return got;
+    return drain(hh, bufs, n);
 }
 
 /* threads: the warp in bands on a pool gives one thread's bytes, in every format, also when
