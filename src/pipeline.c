@@ -137,16 +137,15 @@ static int read_frame_once(home_context *ctx, const uint8_t *image, ptrdiff_t st
     return 1;
 }
 
-int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home_features *out)
+/* The features of a checked image; with snapshot, also the refinement's snapshot of it (else
+ * frame_id and ms_refine are the caller's) */
+static void extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home_features *out,
+                    int snapshot)
 {
     extract_state st;
     double n_values, mean, var, t_end, t_read;
     float scale;
-    int read_once, status = check_ctx(ctx);
-    if (status != HOME_OK) return status;
-    if (!out) return HOME_E_NULL;
-    status = home__check_image(ctx, image, stride);
-    if (status != HOME_OK) return status;
+    int read_once;
 
     memset(&st, 0, sizeof st);
     st.ctx = ctx;
@@ -172,13 +171,25 @@ int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home
     fill_keypoints(ctx, &st.neg, -1, scale, out->kp + out->n_pos);
     out->ms_detect = st.ms_detect;
     out->ms_describe = st.ms_describe + (home__now(ctx) - t_end);
-    t_end = home__now(ctx);
-    out->frame_id = home__refine_store(ctx, read_once ? NULL : image, stride);
-    out->ms_refine = home__now(ctx) - t_end;
+    if (snapshot) {
+        t_end = home__now(ctx);
+        out->frame_id = home__refine_store(ctx, read_once ? NULL : image, stride);
+        out->ms_refine = home__now(ctx) - t_end;
+    }
     out->width = ctx->cfg.width;
     out->height = ctx->cfg.height;
     out->config_id = ctx->config_id;
     out->magic = HOME__MAGIC_FEAT;
+}
+
+int home_extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home_features *out)
+{
+    int status = check_ctx(ctx);
+    if (status != HOME_OK) return status;
+    if (!out) return HOME_E_NULL;
+    status = home__check_image(ctx, image, stride);
+    if (status != HOME_OK) return status;
+    extract(ctx, image, stride, out, 1);
     return HOME_OK;
 }
 
@@ -253,14 +264,22 @@ int home_match(home_context *ctx, const home_features *a, const home_features *b
     return HOME_OK;
 }
 
-/* One pass of home_register() with the live Hough set-up (the images are checked) */
+/* One pass of home_register() with the live Hough set-up (the images are checked). snapshot 0:
+ * the previous pass stored both frames' refinement snapshots, which stay (same frames, same
+ * ids). */
 static void register_pass(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a,
-                          const uint8_t *b, ptrdiff_t stride_b, home_result *result)
+                          const uint8_t *b, ptrdiff_t stride_b, home_result *result, int snapshot)
 {
+    const uint32_t id_a = ctx->slots[0].frame_id, id_b = ctx->slots[1].frame_id;
     reset_result(result);
     ctx->slots_valid = 0;
-    home_extract(ctx, a, stride_a, &ctx->slots[0]);
-    home_extract(ctx, b, stride_b, &ctx->slots[1]);
+    extract(ctx, a, stride_a, &ctx->slots[0], snapshot);
+    extract(ctx, b, stride_b, &ctx->slots[1], snapshot);
+    if (!snapshot) {
+        ctx->slots[0].frame_id = id_a;
+        ctx->slots[1].frame_id = id_b;
+        ctx->slots[0].ms_refine = ctx->slots[1].ms_refine = 0.0;
+    }
     ctx->slots_valid = 1;
     match_and_estimate(ctx, &ctx->slots[0], &ctx->slots[1], result);
     home__refine_apply(ctx, ctx->slots[0].frame_id, ctx->slots[1].frame_id, result);
@@ -283,7 +302,7 @@ int home_register(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const
     if (ctx->n_passes > 1) {
         /* the fast pass: its answer stands when ok; else it only costs its time */
         home__select_pass(ctx, 1);
-        register_pass(ctx, a, stride_a, b, stride_b, result);
+        register_pass(ctx, a, stride_a, b, stride_b, result, 1);
         home__select_pass(ctx, 0);
         if (result->ok) {
             result->fast_pass = 1;
@@ -291,7 +310,7 @@ int home_register(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const
         }
         memcpy(fast_ms, result->ms, sizeof fast_ms);
     }
-    register_pass(ctx, a, stride_a, b, stride_b, result);
+    register_pass(ctx, a, stride_a, b, stride_b, result, ctx->n_passes == 1);
     for (s = 0; s < HOME_STAGE_COUNT; s++) result->ms[s] += fast_ms[s];
     return HOME_OK;
 }
