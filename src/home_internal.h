@@ -50,6 +50,9 @@ typedef struct home__refine_points {
     int n, capacity;
 } home__refine_points;
 
+/* Pixels of the static test's background image at most (src/refine_static.c). */
+#define HOME__BACKGROUND_PIXELS 16384
+
 /* Regions of the refinement's identity test at most (its grid: src/refine_internal.h). */
 #define HOME__MAX_REGIONS 64
 
@@ -67,7 +70,17 @@ typedef struct home__refine_state {
     home__refine_points regions[2];   /* the strongest points of every region of a grid at
                                          region_level, for the identity test (x, y, t only) */
     unsigned char region_faint[2][HOME__MAX_REGIONS]; /* per region: its points are faint */
+    unsigned char region_plain[2][HOME__MAX_REGIONS]; /* per region: no block above the
+                                                          textured floor (faint or flat) */
     int region_level;
+    uint8_t *background[2];           /* each slot's frame at quarter size, box-reduced to at
+                                         most HOME__BACKGROUND_PIXELS: the static test's plain
+                                         regions, pixel by pixel */
+    int background_w, background_h;
+    int background_level, background_factor; /* pyramid level, box side */
+    uint8_t *flat;                    /* match time: which of frame A's background pixels are
+                                         flat, */
+    int16_t *sampled;                 /* ... and frame B there under the motion tested */
     const home__refine_kernels *rk;   /* SIMD backend, as cfg.simd */
     void *scratch;
 } home__refine_state;

@@ -44,6 +44,9 @@
                               * from HOME's estimate contradicts it (2, 3, 5 compared on the
                               * tuning set: docs/trust.md) */
 #define IDENTITY_SIGMAS 2.0  /* a motion within this many predicted errors of the identity is it */
+#define PLAIN_Z 6.0          /* ... and one the identity explains the plain background better
+                                than, at this significance (z score; tuning set: wrong motions
+                                on static fog 11-23, right ones at most 2: docs/trust.md) */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
                                  without HOME's confirmation, the tuning set's wrong refined
@@ -170,9 +173,16 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         const double d_identity = corner_distance(ctx, trial.H, home__refine_identity);
         const int within_sigma =
             isfinite(trial.sigma_px) && d_identity <= IDENTITY_SIGMAS * trial.sigma_px;
+        int against = 0;
         share = clear_share = 0.0;
-        if (!within_sigma) share = home__refine_identity_share(ctx, slot, trial.H, &clear_share);
-        if (within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE) {
+        if (!within_sigma)
+            share = home__refine_identity_share(ctx, slot, trial.H, &clear_share, &against);
+        /* the plain regions, when their pixels show the identity, outweigh the textured regions
+         * that prefer the motion (the background wins by area: a flat occluder in front of
+         * the lens moves with the camera and covers less) */
+        if (within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
+            (home__refine_plain_regions(ctx, slot) > against &&
+             home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z)) {
             memcpy(trial.H, home__refine_identity, sizeof trial.H);
             trial.model = HOME_MODEL_IDENTITY;
             trial.refine_status = HOME_REFINE_STATIC;

@@ -84,6 +84,15 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, home_resu
 
 /* refine_static.c */
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,
-                                   double *clear_share);
+                                   double *clear_share, int *against);
+/* Regions of frame A with no block above the textured floor (faint or flat). */
+int home__refine_plain_regions(const home_context *ctx, int slot);
+/* How much better the identity than h (pixels) explains frame A's plain regions (no block
+ * above the textured floor: fog, sky, a flat wall), every pixel of them in the background image:
+ * the sum of the differences of the two robust costs over its own spread (a z score; positive:
+ * the identity is better; 0 with too few plain regions or pixels). Their few faint
+ * points cannot decide a region's vote, but all their pixels together can: a horizon in fog,
+ * the blocks an encoder left unchanged. */
+double home__refine_plain_background(home_context *ctx, int slot, const double *h);
 
 #endif

@@ -78,6 +78,28 @@ static int finest_for(const home_config *cfg)
  * pass but one 2x2 mean). */
 static int base_for(const home_config *cfg) { return finest_for(cfg) > 0 ? 1 : 0; }
 
+/* The static test's background image: the quarter-size level (noise averaged down) or the
+ * coarsest there is, box-reduced by the smallest factor that leaves at most
+ * HOME__BACKGROUND_PIXELS: the same evidence and cost at every frame size. */
+static void background_size(const home_config *cfg, int *w, int *h, int *level, int *factor)
+{
+    const int levels = levels_for(cfg);
+    const int l = levels > 2 ? 2 : levels - 1;
+    int f = 1;
+    while ((cfg->width >> l) / f * ((cfg->height >> l) / f) > HOME__BACKGROUND_PIXELS) f++;
+    *level = l;
+    *factor = f;
+    *w = (cfg->width >> l) / f;
+    *h = (cfg->height >> l) / f;
+}
+
+static size_t background_bytes(const home_config *cfg)
+{
+    int w, h, l, f;
+    background_size(cfg, &w, &h, &l, &f);
+    return align64((size_t)w * (size_t)h);
+}
+
 /* Points a match-time scratch buffer holds: the finest template's, or the region points. */
 int home__refine_match_capacity(const home_config *cfg)
 {
@@ -115,7 +137,8 @@ size_t home__refine_bytes(const home_config *cfg)
             total += 2 * 5 * align64((size_t)(level_capacity(cfg, l) + LANES) * sizeof(int16_t));
     }
     if (n) total += align64(scratch_bytes(cfg)) +
-                    2 * 3 * align64((size_t)(REGION_CAPACITY + LANES) * sizeof(int16_t));
+                    2 * 3 * align64((size_t)(REGION_CAPACITY + LANES) * sizeof(int16_t)) +
+                    5 * background_bytes(cfg);
     return total;
 }
 
@@ -157,6 +180,18 @@ void home__refine_init(home_context *ctx, unsigned char *block)
         p->x = (int16_t *)(void *)block; block += bytes;
         p->y = (int16_t *)(void *)block; block += bytes;
         p->t = (int16_t *)(void *)block; block += bytes;
+    }
+    if (st->levels) {
+        background_size(&ctx->cfg, &st->background_w, &st->background_h, &st->background_level,
+                        &st->background_factor);
+        for (s = 0; s < 2; s++) {
+            st->background[s] = block;
+            block += background_bytes(&ctx->cfg);
+        }
+        st->flat = block;
+        block += background_bytes(&ctx->cfg);
+        st->sampled = (int16_t *)(void *)block; /* w x h int16 */
+        block += 2 * background_bytes(&ctx->cfg);
     }
     st->scratch = st->levels ? (void *)block : NULL;
 }
@@ -278,7 +313,7 @@ static int region_floor(int level)
 
 static void select_region_points(const uint8_t *img, int w, int h, int level,
                                  const uint16_t *cells, home__refine_points *out,
-                                 unsigned char *faint)
+                                 unsigned char *faint, unsigned char *plain)
 {
     const int b = block_side(level);
     const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
@@ -307,8 +342,10 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
             out->y[r + j] = (int16_t)y;
         }
     }
-    for (r = 0; r < REGIONS_X * REGIONS_Y; r++)
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
         faint[r] = key[r * REGION_TOP] > 0 && key[r * REGION_TOP] < floor_key;
+        plain[r] = key[r * REGION_TOP] < floor_key;
+    }
     for (i = 0; i < REGION_CAPACITY; i++) {
         /* a region with blocks above the floor keeps only those */
         if (!key[i] || (key[i] < floor_key && key[i - i % REGION_TOP] >= floor_key)) continue;
@@ -319,6 +356,22 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
     }
     out->n = n;
     for (; n % LANES; n++) out->x[n] = out->y[n] = out->t[n] = 0;
+}
+
+/* The slot's background image from the pyramid (box means of f x f, rounded). */
+static void store_background(home__refine_state *st, int slot)
+{
+    const int f = st->background_factor, l = st->background_level;
+    const int w = st->background_w, h = st->background_h, stride = st->w[l];
+    int x, y, i, j;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            const uint8_t *p = st->pyr[l] + (ptrdiff_t)(y * f) * stride + x * f;
+            int sum = 0;
+            for (j = 0; j < f; j++)
+                for (i = 0; i < f; i++) sum += p[(ptrdiff_t)j * stride + i];
+            st->background[slot][(ptrdiff_t)y * w + x] = (uint8_t)((sum + f * f / 2) / (f * f));
+        }
 }
 
 /* The selection's block cells, in the scratch after a row of int16 */
@@ -378,7 +431,8 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     l = st->region_level;
     select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
     select_region_points(st->pyr[l], st->w[l], st->h[l], l, cells, &st->regions[slot],
-                         st->region_faint[slot]);
+                         st->region_faint[slot], st->region_plain[slot]);
+    store_background(st, slot);
     st->slot_id[slot] = st->pyr_id;
     return st->pyr_id;
 }

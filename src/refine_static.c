@@ -3,6 +3,7 @@
  * themselves; every region here has its own points, so a plainer background still votes. */
 #include "refine_internal.h"
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define REGION_POINTS 3      /* a region with fewer points does not vote */
@@ -13,6 +14,13 @@
 #define DECISIVE_RATIO_FAINT 0.25
 #define DECISIVE_GREY_FAINT 0.25
 #define MIN_VOTES 6          /* fewer clear votes: no decision (clear_share 0) */
+#define PLAIN_MIN_PIXELS 4   /* fewer plain regions, or fewer usable pixels than this many
+                                regions hold: too little to judge by */
+#define PLAIN_FLAT 4         /* a plain region's pixel counts where no score |gx| + |gy| (2x
+                                central differences) within 2 px reaches this: the tails of
+                                the edges next to it differ in blur between frames */
+#define PLAIN_HIST_BINS 256  /* the identity's residual histogram: 32 grey levels *
+                                8 bins, the rest in one */
 
 /* Share of the frame's regions (a REGIONS_X x REGIONS_Y grid; those with at least REGION_POINTS
  * of the region points vote) whose points the identity explains better than h (pixels) does:
@@ -23,7 +31,7 @@
  * textured and draw the template points (and HOME's lines) to themselves; the static
  * background wins by area. */
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,
-                                    double *clear_share)
+                                    double *clear_share, int *against)
 {
     const home__refine_state *st = &ctx->refine;
     double cost[2][2][REGIONS_X * REGIONS_Y], gain[2], bias[2], hn[9], sigma, c, cost_h, cost_i;
@@ -34,6 +42,7 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
     float m[9];
     home__refine_solver s;
     *clear_share = 0.0;
+    *against = 0;
     home__refine_solver_setup(ctx, slot, &s);
     fl = st->region_level;
     tp = &st->regions[slot];
@@ -92,6 +101,177 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
         clear_votes++;
         clear_wins += cost_i < cost_h;
     }
+    *against = votes - wins;
     *clear_share = clear_votes >= MIN_VOTES ? (double)clear_wins / clear_votes : 0.0;
     return votes >= REGIONS_X * REGIONS_Y / 4 ? (double)wins / votes : 0.0;
+}
+
+/* Bilinear sample of a level image at (u, v) inside [0, w-1] x [0, h-1]. */
+static double sample(const uint8_t *img, int w, int h, double u, double v)
+{
+    int x0 = (int)u, y0 = (int)v;
+    double fx, fy;
+    const uint8_t *p;
+    if (x0 > w - 2) x0 = w - 2;
+    if (y0 > h - 2) y0 = h - 2;
+    fx = u - x0;
+    fy = v - y0;
+    p = img + (ptrdiff_t)y0 * w + x0;
+    return (1.0 - fy) * ((1.0 - fx) * p[0] + fx * p[1]) + fy * ((1.0 - fx) * p[w] + fx * p[w + 1]);
+}
+
+static inline uint8_t max_u8(uint8_t a, uint8_t b) { return a > b ? a : b; }
+
+/* Which pixels of a (w x h) are flat: no score of PLAIN_FLAT or more within 2 px (the border's
+ * two pixels never). tmp: w x h bytes. Plain loops over rows (the compiler vectorises them). */
+static void find_flat(const uint8_t *a, int w, int h, uint8_t *tmp, uint8_t *flat)
+{
+    int x, y;
+    memset(tmp, 255, (size_t)w * (size_t)h);
+    for (y = 1; y < h - 1; y++) {
+        const uint8_t *p = a + (ptrdiff_t)y * w;
+        uint8_t *g = tmp + (ptrdiff_t)y * w;
+        for (x = 1; x < w - 1; x++) {
+            const int s = abs(p[x + 1] - p[x - 1]) + abs(p[x + w] - p[x - w]);
+            g[x] = (uint8_t)(s < 255 ? s : 255);
+        }
+    }
+    /* the largest score of the 5x5 neighbourhood: rows into flat, then columns into tmp */
+    memset(flat, 255, (size_t)w * (size_t)h);
+    for (y = 0; y < h; y++) {
+        const uint8_t *g = tmp + (ptrdiff_t)y * w;
+        uint8_t *o = flat + (ptrdiff_t)y * w;
+        for (x = 2; x < w - 2; x++)
+            o[x] = max_u8(max_u8(max_u8(g[x - 2], g[x - 1]), max_u8(g[x], g[x + 1])), g[x + 2]);
+    }
+    memset(tmp, 255, (size_t)w * (size_t)h);
+    for (y = 2; y < h - 2; y++) {
+        const uint8_t *r0 = flat + (ptrdiff_t)(y - 2) * w, *r1 = r0 + w, *r2 = r1 + w;
+        const uint8_t *r3 = r2 + w, *r4 = r3 + w;
+        uint8_t *o = tmp + (ptrdiff_t)y * w;
+        for (x = 0; x < w; x++)
+            o[x] = max_u8(max_u8(max_u8(r0[x], r1[x]), max_u8(r2[x], r3[x])), r4[x]);
+    }
+    for (x = 0; x < w * h; x++) flat[x] = tmp[x] < PLAIN_FLAT;
+}
+
+/* Sums over the pixels of frame A's plain regions that h maps into frame B, per estimate (0: h,
+ * 1: the identity): for their photometric fits, then the cost differences. */
+typedef struct plain_sums {
+    double n, t, v[2], vv[2], vt[2];
+    double gain[2], bias[2];
+    int hist[PLAIN_HIST_BINS + 1];       /* the identity's |residual|, eighths of a grey level */
+    double d, d2;
+} plain_sums;
+
+/* B at h(x) (m: background pixels) for every flat pixel of a plain region that h maps inside B, in
+ * sixteenths of a grey level (-1: not used), and the sums of the two photometric fits. */
+static void sample_plain(const home__refine_state *st, int slot, const double *m,
+                         int16_t *sampled, plain_sums *acc)
+{
+    const int w = st->background_w, h = st->background_h;
+    const uint8_t *a = st->background[slot], *b = st->background[st->next_slot ^ 1];
+    const unsigned char *plain = st->region_plain[slot];
+    int x, y, r;
+    for (x = 0; x < w * h; x++) sampled[x] = -1;
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
+        /* the region's pixels: region_of(x, y) == r exactly where x * REGIONS_X / w == r % X */
+        const int rx = r % REGIONS_X, ry = r / REGIONS_X;
+        const int x0 = (rx * w + REGIONS_X - 1) / REGIONS_X;
+        const int x1 = ((rx + 1) * w + REGIONS_X - 1) / REGIONS_X;
+        const int y0 = (ry * h + REGIONS_Y - 1) / REGIONS_Y;
+        const int y1 = ((ry + 1) * h + REGIONS_Y - 1) / REGIONS_Y;
+        if (!plain[r]) continue;
+        for (y = y0; y < y1; y++) {
+            for (x = x0; x < x1; x++) {
+                const ptrdiff_t i = (ptrdiff_t)y * w + x;
+                const double den = m[6] * x + m[7] * y + m[8];
+                double u, v, val[2], t;
+                int e;
+                if (!st->flat[i] || !(den > 1e-9)) continue;
+                u = (m[0] * x + m[1] * y + m[2]) / den;
+                v = (m[3] * x + m[4] * y + m[5]) / den;
+                if (!(u >= 0.0 && v >= 0.0 && u <= w - 1 && v <= h - 1)) continue;
+                sampled[i] = (int16_t)floor(16.0 * sample(b, w, h, u, v) + 0.5);
+                val[0] = sampled[i] / 16.0;
+                val[1] = b[i];
+                t = a[i];
+                acc->n += 1.0;
+                acc->t += t;
+                for (e = 0; e < 2; e++) {
+                    acc->v[e] += val[e];
+                    acc->vv[e] += val[e] * val[e];
+                    acc->vt[e] += val[e] * t;
+                }
+            }
+        }
+    }
+}
+
+int home__refine_plain_regions(const home_context *ctx, int slot)
+{
+    int r, n = 0;
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++) n += ctx->refine.region_plain[slot][r] != 0;
+    return n;
+}
+
+double home__refine_plain_background(home_context *ctx, int slot, const double *h)
+{
+    const home__refine_state *st = &ctx->refine;
+    const int w = st->background_w, hh = st->background_h;
+    /* full-size px per background px, and the offset of its centre */
+    const double sc = (double)((1 << st->background_level) * st->background_factor);
+    const double o = 0.5 * (sc - 1.0);
+    const double to_full[9] = {sc, 0, o, 0, sc, o, 0, 0, 1};
+    const double to_level[9] = {1.0 / sc, 0, -o / sc, 0, 1.0 / sc, -o / sc, 0, 0, 1};
+    /* frame B is the one stored last */
+    const uint8_t *a = st->background[slot], *b = st->background[st->next_slot ^ 1];
+    plain_sums acc;
+    double m[9], t[9], spread, sigma, c;
+    int e, i, j, k, half, cum;
+    if (home__refine_plain_regions(ctx, slot) < PLAIN_MIN_PIXELS || w < 2 || hh < 2) return 0.0;
+    /* h in background pixels: background -> full -> h -> background */
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            t[3 * i + j] = 0.0;
+            for (k = 0; k < 3; k++) t[3 * i + j] += h[3 * i + k] * to_full[3 * k + j];
+        }
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            m[3 * i + j] = 0.0;
+            for (k = 0; k < 3; k++) m[3 * i + j] += to_level[3 * i + k] * t[3 * k + j];
+        }
+    find_flat(st->background[slot], w, hh, (uint8_t *)(void *)st->sampled, st->flat);
+    memset(&acc, 0, sizeof acc);
+    sample_plain(st, slot, m, st->sampled, &acc);
+    if (acc.n < PLAIN_MIN_PIXELS * (double)w * hh / (REGIONS_X * REGIONS_Y)) return 0.0;
+    /* each estimate's gain and bias (alpha * B + beta ~ A), least squares over the same pixels */
+    for (e = 0; e < 2; e++) {
+        const double var_v = acc.vv[e] - acc.v[e] * acc.v[e] / acc.n;
+        const double cov = acc.vt[e] - acc.v[e] * acc.t / acc.n;
+        acc.gain[e] = var_v > 1e-9 * acc.n ? cov / var_v : 1.0;
+        acc.bias[e] = (acc.t - acc.gain[e] * acc.v[e]) / acc.n;
+    }
+    /* one scale for both: the identity's robust residual scale, not below the camera floor */
+    for (i = 0; i < w * hh; i++) {
+        double r;
+        if (st->sampled[i] < 0) continue;
+        r = fabs(acc.gain[1] * b[i] + acc.bias[1] - a[i]) * 8.0;
+        acc.hist[r < PLAIN_HIST_BINS ? (int)r : PLAIN_HIST_BINS]++;
+    }
+    half = (int)(acc.n / 2.0);
+    for (i = 0, cum = 0; i < PLAIN_HIST_BINS && cum + acc.hist[i] <= half; i++) cum += acc.hist[i];
+    sigma = 1.4826 * (i + 0.5) / 8.0;
+    if (sigma < SIGMA_FLOOR) sigma = SIGMA_FLOOR;
+    c = CAUCHY_K * sigma;
+    for (i = 0; i < w * hh; i++) {
+        double d;
+        if (st->sampled[i] < 0) continue;
+        d = robust_cost(acc.gain[0] * (st->sampled[i] / 16.0) + acc.bias[0] - a[i], c) -
+            robust_cost(acc.gain[1] * b[i] + acc.bias[1] - a[i], c);
+        acc.d += d;
+        acc.d2 += d * d;
+    }
+    spread = acc.d2 - acc.d * acc.d / acc.n;
+    return spread > 0.0 ? acc.d / sqrt(spread) : 0.0;
 }

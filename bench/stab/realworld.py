@@ -12,8 +12,8 @@ the cut frames (first frame of each new shot) and the blank frames (too dark to 
 Scenarios (each in the tuning and the test half, with other scenes and seeds):
   static     static camera, textured objects moving over 10-30 % of the frame, H.264
              (trust_data.build_static: the trust evaluation's static clips, 300 frames)
-  occluder   one shaky clip twice: as it is, and with a large occluder for 30 frames
-             (tuning: a textured object passing, test: a dark blurred hand at the lens)
+  occluder   one shaky clip as it is and with a large occluder for 30 frames (tuning: a
+             textured object passing, and a dark blurred hand at the lens; test: the hand)
   cuts       three shaky shots of different scenes joined by hard cuts
   fade       a fade to black and back, then a 10-frame dissolve, between three shots
   exposure   gain steps of +-1 EV every 30 frames; a slow auto-exposure ramp (-1 to +1 EV)
@@ -435,14 +435,15 @@ def catalogue():
         add(bg, half, "static", why + " (static), textured objects moving over 10-30 %",
             source + " (trust_catalogue.static_clips)", build_static(half, 0), 300,
             quick=half == "tuning")
-    for half, what, s, kind, seed in (("tuning", leuven, src(leuven), "object", 31),
-                                      ("test", station, src(station), "hand", 41)):
+    for half, what, s, kinds, seed in (("tuning", leuven, src(leuven), ("object", "hand"), 31),
+                                       ("test", station, src(station), ("hand",), 41)):
         add("occl_none_%s" % half, half, "occluder", "shaky, no occluder", s,
             build_occluder(item(photo=what), seed, None))
-        add("occl_%s_%s" % (kind, half), half, "occluder",
-            "shaky, %s covering 30-50 %% for 30 frames" % (
-                "a textured object (graf1.png) passing" if kind == "object"
-                else "a dark blurred hand"), s, build_occluder(item(photo=what), seed, kind))
+        for kind in kinds:
+            add("occl_%s_%s" % (kind, half), half, "occluder",
+                "shaky, %s covering 30-50 %% for 30 frames" % (
+                    "a textured object (graf1.png) passing" if kind == "object"
+                    else "a dark blurred hand"), s, build_occluder(item(photo=what), seed, kind))
     add("cuts_tuning", "tuning", "cuts", "three shots joined by hard cuts (frames 50, 100)",
         "; ".join(map(src, (building, baboon, motorcycle))),
         build_shots([(item(photo=building), 50, 51), (item(photo=baboon), 50, 52),
