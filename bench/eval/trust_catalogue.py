@@ -30,6 +30,11 @@ explore_farm_animals.rcc; Hugin's manual), with other seeds (a salt) and a
 wider moving share.  `--sets sealed` selects it; it has no still pairs and no
 hand-held frames.
 
+Static clips are H.264 round trips (as camera files are), except those whose
+Item has condition "raw": a live camera's frames straight from the sensor, with
+new noise in every frame (session 13; one in the tuning set, one in the test
+set).
+
 The sources the project reserves for independent checks (the developers' guide
 lists them) are never used here.  No real static-camera footage with people was
 found among the other sources, so the static-camera clips are synthesised only.
@@ -88,7 +93,7 @@ class Item:
     why: str
     photo: Photo = None
     scene: tuple = None          # (kind, variant "A"/"B", seed name)
-    condition: str = None        # None, "fog", "defocus", "lowlight"
+    condition: str = None        # None, "fog", "defocus", "lowlight"; static clips: "raw"
 
     @property
     def name(self):
@@ -395,7 +400,12 @@ def static_clips(which):
                       photo=_tp("home"), condition="fog"), tex),
                 # added in session 10 (issue 18: a tripod shot of a horizon in fog)
                 (Item("ridge line in fog (static, textureless), objects moving in front",
-                      scene=("fog_horizon", "A", "static0")), tex)]
+                      scene=("fog_horizon", "A", "static0")), tex),
+                # added in session 13: a live camera's raw frames (no encoder, so every
+                # frame's noise is new), another ridge in fog
+                (Item("ridge line in fog (static, textureless, raw frames: no encoder), "
+                      "objects moving in front", scene=("fog_horizon", "A", "static1"),
+                      condition="raw"), tex)]
     if which == "sealed":
         S = SEALED
         tex = [S["jaguars"], S["hedgehog"], S["komodo"], S["sheep"]]
@@ -408,7 +418,10 @@ def static_clips(which):
             (Item("flower field (static, dense texture), objects moving in front",
                   photo=T["flowers"]), tex),
             (Item("sea horizon in haze (static), objects moving in front",
-                   scene=("fog_horizon", "B", "static0")), tex)]
+                   scene=("fog_horizon", "B", "static0")), tex),
+            # added in session 13 with the tuning set's raw clip (never looked at before)
+            (Item("sea horizon in haze (static, raw frames: no encoder), objects moving in "
+                  "front", scene=("fog_horizon", "B", "static1"), condition="raw"), tex)]
 
 
 QUICK = {

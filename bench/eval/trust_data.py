@@ -344,6 +344,16 @@ def render_static(bg, objs, t):
     return img
 
 
+def write_y4m(path, frames):
+    """Grey frames as 4:2:0 Y4M with neutral chroma, 30 fps."""
+    h, w = frames[0].shape
+    chroma = np.full(w * h // 2, 128, np.uint8).tobytes()
+    with open(path, "wb") as f:
+        f.write(b"YUV4MPEG2 W%d H%d F30:1 Ip A1:1 C420jpeg\n" % (w, h))
+        for fr in frames:
+            f.write(b"FRAME\n" + np.ascontiguousarray(fr, np.uint8).tobytes() + chroma)
+
+
 def read_y4m_luma(path):
     """Y planes of a 4:2:0 Y4M file, as uint8 arrays."""
     data = Path(path).read_bytes()
@@ -401,31 +411,41 @@ def build_static(lib, which, quick, root, catalogue, frames, jobs=2):
             bg = world(lib, bg_item, CROP_W, CROP_H)
             objs = _static_objects(lib, key, textures, frames, bg, catalogue, which)
             noise = rng_for(key + "|noise")
+            raw = bg_item.condition == "raw"   # a live camera's frames: no encoder
             mp4 = d / "clip.mp4"
-            enc = subprocess.Popen(
-                ["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "gray",
-                 "-s", f"{CROP_W}x{CROP_H}", "-r", "30", "-i", "-", "-c:v", "libx264",
-                 "-preset", "medium", "-crf", str(STATIC_CRF), "-pix_fmt", "yuv420p",
-                 str(mp4)], stdin=subprocess.PIPE)
-            cover = []
+            if not raw:
+                enc = subprocess.Popen(
+                    ["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "gray",
+                     "-s", f"{CROP_W}x{CROP_H}", "-r", "30", "-i", "-", "-c:v", "libx264",
+                     "-preset", "medium", "-crf", str(STATIC_CRF), "-pix_fmt", "yuv420p",
+                     str(mp4)], stdin=subprocess.PIPE)
+            cover, raw_frames = [], []
             for t in range(frames):
                 img = render_static(bg, objs, t)
                 f = to_u8(img + noise.normal(0, NOISE_SIGMA, img.shape))
-                enc.stdin.write(f.tobytes())
+                if raw:
+                    raw_frames.append(f)
+                else:
+                    enc.stdin.write(f.tobytes())
                 if t % 25 == 0:
                     cover.append(float(np.mean(np.abs(img - bg) > 0.5)))
-            enc.stdin.close()
-            if enc.wait() != 0:
-                raise RuntimeError("ffmpeg (libx264 encode) failed")
-            subprocess.run(["ffmpeg", "-loglevel", "error", "-y", "-i", str(mp4),
-                            "-f", "yuv4mpegpipe", "-pix_fmt", "yuv420p", str(y4m)], check=True)
+            if raw:
+                write_y4m(y4m, raw_frames)
+            else:
+                enc.stdin.close()
+                if enc.wait() != 0:
+                    raise RuntimeError("ffmpeg (libx264 encode) failed")
+                subprocess.run(["ffmpeg", "-loglevel", "error", "-y", "-i", str(mp4),
+                                "-f", "yuv4mpegpipe", "-pix_fmt", "yuv420p", str(y4m)],
+                               check=True)
             lumas = read_y4m_luma(y4m)
             if len(lumas) != frames:
                 raise RuntimeError(f"{y4m}: {len(lumas)} frames decoded, {frames} encoded")
             for t, f in enumerate(lumas):
                 write_pgm(d / f"{t:03d}.pgm", np.ascontiguousarray(f))
-            gt = {"gen": GEN, "frames": frames, "crf": STATIC_CRF,
-                  "kbps": mp4.stat().st_size * 8 / (frames / 30) / 1000,
+            gt = {"gen": GEN, "frames": frames, "crf": None if raw else STATIC_CRF,
+                  "kbps": (CROP_W * CROP_H * 8 * 30 / 1000 if raw
+                           else mp4.stat().st_size * 8 / (frames / 30) / 1000),
                   "moving_share_max": max(cover)}
             (d / "gt.json").write_text(json.dumps(gt))
         recs = [{"set": which, "suite": "static", "group": bg_item.name, "row": bg_item.name,
