@@ -187,6 +187,30 @@ void test_few_edges_never_wrong(void)
     }
 }
 
+/* The mover tests' four configurations: bit 0 the video preset, 2 and 3 capped at a
+ * similarity. */
+static home_context *mover_context(int config)
+{
+    return context_for(config & 1, config < 2 ? HOME_MODEL_HOMOGRAPHY : HOME_MODEL_SIMILARITY);
+}
+
+/* A turn by angle about (ox, oy) and a (dx, dy) px shift. */
+static void turn_and_shift(double angle, double ox, double oy, double dx, double dy, double *h)
+{
+    const double c = cos(angle), s = sin(angle);
+    const double m[9] = {c, -s, ox - c * ox + s * oy + dx, s, c, oy - s * ox - c * oy + dy,
+                         0, 0, 1};
+    memcpy(h, m, sizeof m);
+}
+
+static void print_mover_result(int config, const home_result *res, double err)
+{
+    printf("     %s, cap %s: ok %d, model %s, failure %s, refine %s, error %.3f px\n",
+           config & 1 ? "video" : "defaults", config < 2 ? "homography" : "similarity", res->ok,
+           home_model_name(res->model), home_failure_name(res->failure),
+           home_refine_status_name(res->refine_status), err);
+}
+
 /* A static camera over a plain background with a few faint long edges, and a structured object
  * (a quarter of the frame, strong edges) moving and turning across it: the object draws HOME's
  * lines and the refinement's template to itself, yet the answer is never its motion. Either the
@@ -196,14 +220,13 @@ void test_textured_mover_never_steers(void)
     static const double lines[4][3] = {
         {0.93, 0.36, -260}, {-0.2, 0.98, -150}, {0.6, -0.8, 40}, {0.1, 0.99, -300}};
     static uint8_t object[IMG_W * IMG_H];
-    const double c = cos(0.02), s = sin(0.02), ox = 420.0, oy = 190.0, dx = 5.0, dy = 2.0;
-    /* the object's motion: a 0.02 rad turn about its centre and a (5, 2) px shift */
-    const double h_obj[9] = {c, -s, ox - c * ox + s * oy + dx, s, c, oy - s * ox - c * oy + dy,
-                             0, 0, 1};
+    const double ox = 420.0, oy = 190.0, dx = 5.0, dy = 2.0;
+    double h_obj[9];
     int config, identities = 0;
+    /* the object's motion: a 0.02 rad turn about its centre and a (5, 2) px shift */
+    turn_and_shift(0.02, ox, oy, dx, dy, h_obj);
     for (config = 0; config < 4; config++) {
-        home_context *ctx = context_for(config & 1, config < 2 ? HOME_MODEL_HOMOGRAPHY
-                                                                : HOME_MODEL_SIMILARITY);
+        home_context *ctx = mover_context(config);
         home_result res;
         int pass;
         double err;
@@ -232,10 +255,7 @@ void test_textured_mover_never_steers(void)
         }
         CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
         err = synth_corner_error(res.H, identity, IMG_W, IMG_H);
-        printf("     %s, cap %s: ok %d, model %s, failure %s, refine %s, error %.3f px\n",
-               config & 1 ? "video" : "defaults", config < 2 ? "homography" : "similarity",
-               res.ok, home_model_name(res.model), home_failure_name(res.failure),
-               home_refine_status_name(res.refine_status), err);
+        print_mover_result(config, &res, err);
         if (res.ok) CHECK_LT(err, 0.05);
         identities += res.ok && res.model == HOME_MODEL_IDENTITY;
     }
@@ -253,13 +273,12 @@ void test_textured_mover_never_steers(void)
 void test_static_fog_is_identity(void)
 {
     static uint8_t object[IMG_W * IMG_H];
-    const double c = cos(0.03), s = sin(0.03), ox = 470.0, oy = 110.0, dx = 6.0, dy = 3.0;
-    const double h_obj[9] = {c, -s, ox - c * ox + s * oy + dx, s, c, oy - s * ox - c * oy + dy,
-                             0, 0, 1};
+    const double ox = 470.0, oy = 110.0, dx = 6.0, dy = 3.0;
+    double h_obj[9];
     int config, identities = 0;
+    turn_and_shift(0.03, ox, oy, dx, dy, h_obj);
     for (config = 0; config < 4; config++) {
-        home_context *ctx = context_for(config & 1, config < 2 ? HOME_MODEL_HOMOGRAPHY
-                                                                : HOME_MODEL_SIMILARITY);
+        home_context *ctx = mover_context(config);
         home_result res;
         double err;
         int pass;
@@ -286,10 +305,7 @@ void test_static_fog_is_identity(void)
         }
         CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
         err = synth_corner_error(res.H, identity, IMG_W, IMG_H);
-        printf("     %s, cap %s: ok %d, model %s, failure %s, refine %s, error %.3f px\n",
-               config & 1 ? "video" : "defaults", config < 2 ? "homography" : "similarity",
-               res.ok, home_model_name(res.model), home_failure_name(res.failure),
-               home_refine_status_name(res.refine_status), err);
+        print_mover_result(config, &res, err);
         if (res.ok) CHECK_EQ_INT(res.model, HOME_MODEL_IDENTITY);
         identities += res.ok && res.model == HOME_MODEL_IDENTITY;
     }

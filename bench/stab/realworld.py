@@ -393,16 +393,6 @@ def read_pgm(data):
     return np.frombuffer(data, np.uint8, w * h, m.end()).reshape(h, w)
 
 
-def write_y4m(path, frames):
-    """Grey frames as 4:2:0 Y4M with neutral chroma, 30 fps."""
-    h, w = frames[0].shape
-    chroma = np.full(w * h // 2, 128, np.uint8).tobytes()
-    with open(path, "wb") as f:
-        f.write(b"YUV4MPEG2 W%d H%d F30:1 Ip A1:1 C420jpeg\n" % (w, h))
-        for fr in frames:
-            f.write(b"FRAME\n" + np.ascontiguousarray(fr, np.uint8).tobytes() + chroma)
-
-
 def catalogue():
     """Every clip of the set: the tuning half first."""
     P = photo
@@ -537,7 +527,8 @@ class Context:
             if frames != y4m:
                 y4m.write_bytes(frames.read_bytes())
         else:
-            write_y4m(y4m, frames)
+            import trust_data
+            trust_data.write_y4m(y4m, frames)
         meta.write_text(json.dumps({"gen": GEN, "truth": truth}))
         return y4m, truth
 
