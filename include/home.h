@@ -243,9 +243,12 @@ enum home_refine_status {
     HOME_REFINE_LOW_CORRELATION,  /* HOME failed and the refinement cannot vouch (rule below) */
     HOME_REFINE_LESS_PRECISE,     /* the refined H agrees with HOME's but predicts a larger
                                      error (sigma_px): HOME's H stays */
-    HOME_REFINE_STATIC            /* a motion most of the frame's regions do not share
+    HOME_REFINE_STATIC,           /* a motion most of the frame's regions do not share
                                      (moving objects), or one within 2 sigma_px of the
                                      identity: H is the identity */
+    HOME_REFINE_STILL_BACKGROUND  /* the frame's plain background (fog, a flat wall) stays
+                                     where the motion would move it: the moving objects'
+                                     motion, not ok (HOME_FAIL_INCONSISTENT) */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */
@@ -307,7 +310,12 @@ typedef struct home_result {
  * identity (HOME_REFINE_STATIC). One the identity clearly explains better in a tenth of the
  * clearly decided regions is two motions, not ok (HOME_FAIL_INCONSISTENT); so is HOME's kept
  * estimate when the refinement converged ill-conditioned more than 2 predicted errors (both
- * estimates') away from it. */
+ * estimates') away from it. The plain background judges pixel by pixel: a motion becomes the
+ * identity when the plain regions (no textured block) outnumber the textured regions that prefer
+ * it and their flat pixels prefer the identity at z >= 6; and it is not ok
+ * (HOME_REFINE_STILL_BACKGROUND, HOME_FAIL_INCONSISTENT) when the frame's background away from
+ * texture would show it clearly (a z score of 5, spread over the background) and shows less
+ * than a third of it: textured objects moving over fog or a flat wall. */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 

@@ -50,6 +50,7 @@ const char *home_refine_status_name(int status)
     case HOME_REFINE_LOW_CORRELATION: return "low_correlation";
     case HOME_REFINE_LESS_PRECISE: return "less_precise";
     case HOME_REFINE_STATIC: return "static";
+    case HOME_REFINE_STILL_BACKGROUND: return "still_background";
     default: return "unknown";
     }
 }

@@ -76,11 +76,15 @@ typedef struct home__refine_state {
     uint8_t *background[2];           /* each slot's frame at quarter size, box-reduced to at
                                          most HOME__BACKGROUND_PIXELS: the static test's plain
                                          regions, pixel by pixel */
+    uint16_t *background16[2];        /* the same in sixteenths of a grey level, from the
+                                         finer level: the background score test */
     int background_w, background_h;
     int background_level, background_factor; /* pyramid level, box side */
     uint8_t *flat;                    /* match time: which of frame A's background pixels are
                                          flat, */
-    int16_t *sampled;                 /* ... and frame B there under the motion tested */
+    int16_t *sampled;                 /* ... and frame B there under the motion tested (the
+                                         score test: frame A smoothed) */
+    int16_t *smoothed_b;              /* the score test: frame B smoothed */
     const home__refine_kernels *rk;   /* SIMD backend, as cfg.simd */
     void *scratch;
 } home__refine_state;

@@ -47,6 +47,9 @@
 #define PLAIN_Z 6.0          /* ... and one the identity explains the plain background better
                                 than, at this significance (z score; tuning set: wrong motions
                                 on static fog 11-23, right ones at most 2: docs/trust.md) */
+#define BACKGROUND_EVIDENCE 5.0 /* ... and one the background would show at this z score, but
+                                   does not show at a third of it (refine_background.c; tuning
+                                   set: docs/trust.md) */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
                                  without HOME's confirmation, the tuning set's wrong refined
@@ -174,6 +177,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         const int within_sigma =
             isfinite(trial.sigma_px) && d_identity <= IDENTITY_SIGMAS * trial.sigma_px;
         int against = 0;
+        double observed, expected, evidence;
         share = clear_share = 0.0;
         if (!within_sigma)
             share = home__refine_identity_share(ctx, slot, trial.H, &clear_share, &against);
@@ -193,6 +197,16 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
              * HOME's lines 1-1.5 px off, the optimum 4-8 px away): neither can be vouched for */
             trial.ok = 0;
             trial.failure = HOME_FAIL_INCONSISTENT;
+        } else if (home__refine_background_score(ctx, st->background16[slot],
+                                                 st->background16[st->next_slot ^ 1], trial.H,
+                                                 &observed, &expected, &evidence) &&
+                   expected >= BACKGROUND_EVIDENCE && evidence >= BACKGROUND_EVIDENCE &&
+                   observed < expected / 3.0) {
+            /* ... or the background would show the motion clearly, and shows far less of it
+             * than predicted: the moving objects' motion over a still background */
+            trial.ok = 0;
+            trial.failure = HOME_FAIL_INCONSISTENT;
+            trial.refine_status = HOME_REFINE_STILL_BACKGROUND;
         }
     }
     *result = trial;

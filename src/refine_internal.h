@@ -83,6 +83,8 @@ double home__refine_max_corner_distance(double cx, double cy, const double *h1,
 double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result);
 
 /* refine_static.c */
+/* h (full-size pixels) as a map of background pixels, into m. */
+void home__refine_background_matrix(const home__refine_state *st, const double *h, double *m);
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,
                                    double *clear_share, int *against);
 /* Regions of frame A with no block above the textured floor (faint or flat). */
@@ -94,5 +96,15 @@ int home__refine_plain_regions(const home_context *ctx, int slot);
  * points cannot decide a region's vote, but all their pixels together can: a horizon in fog,
  * the blocks an encoder left unchanged. */
 double home__refine_plain_background(home_context *ctx, int slot, const double *h);
+
+/* refine_background.c: the score test of h (pixels, A -> B) on the fine backgrounds a and b
+ * (background16 images: refine.background_w x background_h) at the pixels away from texture.
+ * observed: the identity's residual projected on the one h predicts, over its noise (about
+ * N(0, 1) if the background stands still); expected: the same if h were the background's
+ * motion; evidence: expected over the spread of its per-pixel terms. Returns 0 (all 0) when
+ * there is too little background or no refinement. Uses the match-time scratch. */
+int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
+                                  const double *h, double *observed, double *expected,
+                                  double *evidence);
 
 #endif

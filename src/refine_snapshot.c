@@ -138,7 +138,7 @@ size_t home__refine_bytes(const home_config *cfg)
     }
     if (n) total += align64(scratch_bytes(cfg)) +
                     2 * 3 * align64((size_t)(REGION_CAPACITY + LANES) * sizeof(int16_t)) +
-                    5 * background_bytes(cfg);
+                    11 * background_bytes(cfg);
     return total;
 }
 
@@ -188,9 +188,15 @@ void home__refine_init(home_context *ctx, unsigned char *block)
             st->background[s] = block;
             block += background_bytes(&ctx->cfg);
         }
+        for (s = 0; s < 2; s++) {
+            st->background16[s] = (uint16_t *)(void *)block;
+            block += 2 * background_bytes(&ctx->cfg);
+        }
         st->flat = block;
         block += background_bytes(&ctx->cfg);
         st->sampled = (int16_t *)(void *)block; /* w x h int16 */
+        block += 2 * background_bytes(&ctx->cfg);
+        st->smoothed_b = (int16_t *)(void *)block;
         block += 2 * background_bytes(&ctx->cfg);
     }
     st->scratch = st->levels ? (void *)block : NULL;
@@ -372,6 +378,31 @@ static void store_background(home__refine_state *st, int slot)
                 for (i = 0; i < f; i++) sum += p[(ptrdiff_t)j * stride + i];
             st->background[slot][(ptrdiff_t)y * w + x] = (uint8_t)((sum + f * f / 2) / (f * f));
         }
+    /* the same boxes from the finer level, in sixteenths: the score test's evidence is below
+       a grey level at quarter size */
+    {
+        const int src = l > st->base_level ? l - 1 : l, g = f << (l - src);
+        const int src_stride = st->w[src];
+        if (g == 2) {   /* the usual case: 16 x the mean of 2 x 2 is 4 x their sum, exactly */
+            for (y = 0; y < h; y++) {
+                const uint8_t *r0 = st->pyr[src] + (ptrdiff_t)(2 * y) * src_stride;
+                const uint8_t *r1 = r0 + src_stride;
+                uint16_t *o = st->background16[slot] + (ptrdiff_t)y * w;
+                for (x = 0; x < w; x++)
+                    o[x] = (uint16_t)(4 * (r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1]));
+            }
+            return;
+        }
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                const uint8_t *p = st->pyr[src] + (ptrdiff_t)(y * g) * src_stride + x * g;
+                long sum = 0;
+                for (j = 0; j < g; j++)
+                    for (i = 0; i < g; i++) sum += p[(ptrdiff_t)j * src_stride + i];
+                st->background16[slot][(ptrdiff_t)y * w + x] =
+                    (uint16_t)((16 * sum + g * g / 2) / (g * g));
+            }
+    }
 }
 
 /* The selection's block cells, in the scratch after a row of int16 */

@@ -208,6 +208,25 @@ static void sample_plain(const home__refine_state *st, int slot, const double *m
     }
 }
 
+void home__refine_background_matrix(const home__refine_state *st, const double *h, double *m)
+{
+    /* full-size px per background px, and the offset of its centre */
+    const double sc = (double)((1 << st->background_level) * st->background_factor);
+    const double o = 0.5 * (sc - 1.0);
+    const double to_full[9] = {sc, 0, o, 0, sc, o, 0, 0, 1};
+    const double to_level[9] = {1.0 / sc, 0, -o / sc, 0, 1.0 / sc, -o / sc, 0, 0, 1};
+    double t[9];
+    int i, j, k;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            for (t[3 * i + j] = 0.0, k = 0; k < 3; k++)
+                t[3 * i + j] += h[3 * i + k] * to_full[3 * k + j];
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            for (m[3 * i + j] = 0.0, k = 0; k < 3; k++)
+                m[3 * i + j] += to_level[3 * i + k] * t[3 * k + j];
+}
+
 int home__refine_plain_regions(const home_context *ctx, int slot)
 {
     int r, n = 0;
@@ -219,28 +238,13 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
 {
     const home__refine_state *st = &ctx->refine;
     const int w = st->background_w, hh = st->background_h;
-    /* full-size px per background px, and the offset of its centre */
-    const double sc = (double)((1 << st->background_level) * st->background_factor);
-    const double o = 0.5 * (sc - 1.0);
-    const double to_full[9] = {sc, 0, o, 0, sc, o, 0, 0, 1};
-    const double to_level[9] = {1.0 / sc, 0, -o / sc, 0, 1.0 / sc, -o / sc, 0, 0, 1};
     /* frame B is the one stored last */
     const uint8_t *a = st->background[slot], *b = st->background[st->next_slot ^ 1];
     plain_sums acc;
-    double m[9], t[9], spread, sigma, c;
-    int e, i, j, k, half, cum;
+    double m[9], spread, sigma, c;
+    int e, i, half, cum;
     if (home__refine_plain_regions(ctx, slot) < PLAIN_MIN_PIXELS || w < 2 || hh < 2) return 0.0;
-    /* h in background pixels: background -> full -> h -> background */
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++) {
-            t[3 * i + j] = 0.0;
-            for (k = 0; k < 3; k++) t[3 * i + j] += h[3 * i + k] * to_full[3 * k + j];
-        }
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++) {
-            m[3 * i + j] = 0.0;
-            for (k = 0; k < 3; k++) m[3 * i + j] += to_level[3 * i + k] * t[3 * k + j];
-        }
+    home__refine_background_matrix(st, h, m);
     find_flat(st->background[slot], w, hh, (uint8_t *)(void *)st->sampled, st->flat);
     memset(&acc, 0, sizeof acc);
     sample_plain(st, slot, m, st->sampled, &acc);

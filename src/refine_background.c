@@ -1,0 +1,292 @@
+/* Does the background move as a motion says? A score test on the pixels of both frames' fine
+ * backgrounds (quarter size, sixteenths of a grey level) away from texture.
+ *
+ * Where the background is faint (fog, a flat wall) and fresh noise differs in every frame, the
+ * robust costs of the static test (refine_static.c) cannot tell a motion of a few pixels from
+ * none: bilinear sampling averages the noise and favours any fractional motion. The residual of
+ * the identity, r = B - A, can, without resampling it: if h were the background's motion, r
+ * would follow p = -grad(I) . d (I smoothed, d the displacement h gives), and if the camera
+ * stood still, r is noise, uncorrelated with p. Standardised by the noise,
+ * observed = <r, p> / (sigma |p|) is about N(0, 1) under the identity, and under h about
+ * expected = <r_h, p> / (sigma |p|), where r_h is what r would be under h, predicted from each
+ * frame alone (A at h^-1(x) minus A(x), paired with B's p; B(x) minus B at h(x), paired with
+ * A's): the frames' noises are independent, so the prediction carries no noise bias, and it
+ * holds however fine the background's detail. evidence is expected over the spread of its
+ * per-pixel terms: how much of the frame it rests on (a few edge pixels next to the mask
+ * decide nothing). Gain and bias (exposure) are projected out; residuals far from the median
+ * (occlusion) and clipped pixels are left out. */
+#include "refine_internal.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TEXTURE_SCORE 128   /* |gx| + |gy| (2x central differences, sixteenths): texture, */
+#define TEXTURE_NEAR 4      /* ... and the pixels within this many of it are not background
+                               (moving objects, their edges and what they uncover) */
+#define BORDER 3            /* pixels at the border: no gradient of the smoothed image */
+#define CLIP_MARGIN 8       /* sixteenths: a pixel this close to 0 or 255 is clipped */
+#define REJECT_SIGMAS 4.0   /* residuals farther from the median: occluded or changed */
+#define HIST_BINS 512       /* |r - median| in halves of a sixteenth (the rest in one); r's
+                               grey levels for its median */
+#define MIN_SHARE 48        /* fewer than 1/MIN_SHARE of the pixels: no test */
+
+/* The background of A and B in sixteenths smoothed by the 5-tap binomial (sigma 1 px) in both
+ * directions, edges replicated. */
+static void smooth(const uint16_t *in, int w, int h, int16_t *out)
+{
+    int x, y;
+    for (y = 0; y < h; y++) {
+        const uint16_t *r0 = in + (ptrdiff_t)(y < 2 ? 0 : y - 2) * w;
+        const uint16_t *r1 = in + (ptrdiff_t)(y < 1 ? 0 : y - 1) * w;
+        const uint16_t *r2 = in + (ptrdiff_t)y * w;
+        const uint16_t *r3 = in + (ptrdiff_t)(y + 1 >= h ? h - 1 : y + 1) * w;
+        const uint16_t *r4 = in + (ptrdiff_t)(y + 2 >= h ? h - 1 : y + 2) * w;
+        int16_t *o = out + (ptrdiff_t)y * w;
+        for (x = 0; x < w; x++)
+            o[x] = (int16_t)((r0[x] + 4 * r1[x] + 6 * r2[x] + 4 * r3[x] + r4[x] + 8) >> 4);
+    }
+    for (y = 0; y < h; y++) {
+        int16_t *o = out + (ptrdiff_t)y * w;
+        int m2 = o[0], m1 = o[0], c = o[0];
+        for (x = 0; x < w; x++) {
+            const int p1 = o[x + 1 < w ? x + 1 : w - 1], p2 = o[x + 2 < w ? x + 2 : w - 1];
+            o[x] = (int16_t)((m2 + 4 * m1 + 6 * c + 4 * p1 + p2 + 8) >> 4);
+            m2 = m1;
+            m1 = c;
+            c = p1;
+        }
+    }
+}
+
+/* Which pixels are background: no texture in A or B within TEXTURE_NEAR, neither clipped, not at
+ * the border. tmp: w x h bytes. */
+static void find_background(const uint16_t *a, const uint16_t *b, int w, int h, uint8_t *tmp,
+                            uint8_t *mask)
+{
+    int x, y, k;
+    memset(mask, 0, (size_t)w * (size_t)h);
+    for (y = 1; y < h - 1; y++)
+        for (x = 1; x < w - 1; x++) {
+            const ptrdiff_t i = (ptrdiff_t)y * w + x;
+            const int sa = abs(a[i + 1] - a[i - 1]) + abs(a[i + w] - a[i - w]);
+            const int sb = abs(b[i + 1] - b[i - 1]) + abs(b[i + w] - b[i - w]);
+            mask[i] = sa >= TEXTURE_SCORE || sb >= TEXTURE_SCORE;
+        }
+    /* texture dilated by running counts over the window: rows into tmp, then columns back */
+    for (y = 0; y < h; y++) {
+        const uint8_t *in = mask + (ptrdiff_t)y * w;
+        uint8_t *out = tmp + (ptrdiff_t)y * w;
+        int count = 0;
+        for (k = 0; k < TEXTURE_NEAR && k < w; k++) count += in[k];
+        for (x = 0; x < w; x++) {
+            if (x + TEXTURE_NEAR < w) count += in[x + TEXTURE_NEAR];
+            if (x - TEXTURE_NEAR - 1 >= 0) count -= in[x - TEXTURE_NEAR - 1];
+            out[x] = count > 0;
+        }
+    }
+    for (x = 0; x < w; x++) {
+        int count = 0;
+        for (k = 0; k < TEXTURE_NEAR && k < h; k++) count += tmp[(ptrdiff_t)k * w + x];
+        for (y = 0; y < h; y++) {
+            const ptrdiff_t i = (ptrdiff_t)y * w + x;
+            if (y + TEXTURE_NEAR < h) count += tmp[i + (ptrdiff_t)TEXTURE_NEAR * w];
+            if (y - TEXTURE_NEAR - 1 >= 0) count -= tmp[i - (ptrdiff_t)(TEXTURE_NEAR + 1) * w];
+            /* clipped pixels hold no noise and no motion */
+            mask[i] = !count && x >= BORDER && y >= BORDER && x < w - BORDER && y < h - BORDER &&
+                      a[i] > CLIP_MARGIN && b[i] > CLIP_MARGIN && a[i] < 4080 - CLIP_MARGIN &&
+                      b[i] < 4080 - CLIP_MARGIN;
+        }
+    }
+}
+
+/* Bilinear sample (sixteenths) of a w x h image at (u, v) into out; 0 outside [0, w-1] x
+ * [0, h-1]. */
+static int sample16(const uint16_t *img, int w, int h, double u, double v, double *out)
+{
+    int x0, y0;
+    double fx, fy;
+    const uint16_t *p;
+    if (!(u >= 0.0 && v >= 0.0 && u <= w - 1 && v <= h - 1)) return 0;
+    x0 = (int)u;
+    y0 = (int)v;
+    if (x0 > w - 2) x0 = w - 2;
+    if (y0 > h - 2) y0 = h - 2;
+    fx = u - x0;
+    fy = v - y0;
+    p = img + (ptrdiff_t)y0 * w + x0;
+    *out = (1.0 - fy) * ((1.0 - fx) * p[0] + fx * p[1]) + fy * ((1.0 - fx) * p[w] + fx * p[w + 1]);
+    return 1;
+}
+
+/* The inverse of the 3x3 matrix m into inv; 0 when singular. */
+static int invert3(const double *m, double *inv)
+{
+    const double c0 = m[4] * m[8] - m[5] * m[7], c1 = m[5] * m[6] - m[3] * m[8];
+    const double c2 = m[3] * m[7] - m[4] * m[6], det = m[0] * c0 + m[1] * c1 + m[2] * c2;
+    if (!(fabs(det) > 1e-12)) return 0;
+    inv[0] = c0 / det;
+    inv[1] = (m[2] * m[7] - m[1] * m[8]) / det;
+    inv[2] = (m[1] * m[5] - m[2] * m[4]) / det;
+    inv[3] = c1 / det;
+    inv[4] = (m[0] * m[8] - m[2] * m[6]) / det;
+    inv[5] = (m[2] * m[3] - m[0] * m[5]) / det;
+    inv[6] = c2 / det;
+    inv[7] = (m[1] * m[6] - m[0] * m[7]) / det;
+    inv[8] = (m[0] * m[4] - m[1] * m[3]) / det;
+    return 1;
+}
+
+/* (u, v) = m (x, y), 0 behind the camera. */
+static int apply(const double *m, double x, double y, double *u, double *v)
+{
+    const double den = m[6] * x + m[7] * y + m[8];
+    if (!(den > 1e-9)) return 0;
+    *u = (m[0] * x + m[1] * y + m[2]) / den;
+    *v = (m[3] * x + m[4] * y + m[5]) / den;
+    return 1;
+}
+
+/* Sums over the background pixels for inner products with [1, A] projected out. */
+enum { V_R, V_P, V_PA, V_PB, V_QA, V_QB, N_V };
+typedef struct score_sums {
+    double n, a, aa;
+    double s[N_V], sa[N_V];         /* sum of v, of v * A */
+    double rr, rp, pp, qapb, qbpa;  /* the inner products used */
+    double e, ee;                   /* the expected's terms: sum, sum of squares */
+} score_sums;
+
+/* <u, v> with the constant and A projected out */
+static double projected(const score_sums *k, double uv, int u, int v)
+{
+    const double det = k->n * k->aa - k->a * k->a;
+    if (!(det > 0.0)) return uv - k->s[u] * k->s[v] / k->n;
+    return uv - (k->s[u] * (k->aa * k->s[v] - k->a * k->sa[v]) +
+                 k->sa[u] * (k->n * k->sa[v] - k->a * k->s[v])) / det;
+}
+
+/* The background pixels (mask) both h (m, background pixels) and its inverse (m_inv) keep
+ * inside the frame, their count, and the median and spread of r = B - A there (sixteenths).
+ * 0 when there are too few. */
+static long prepare(const home__refine_state *st, const uint16_t *a, const uint16_t *b,
+                    const double *h, double *m, double *m_inv, double *median, double *mad)
+{
+    const int w = st->background_w, hh = st->background_h;
+    uint8_t *mask = st->flat;
+    int hist[HIST_BINS + 1], fine[16], x, y, i, j, f, half, cum;
+    long n = 0;
+    if (!st->levels || w < 2 * BORDER + 2 || hh < 2 * BORDER + 2) return 0;
+    home__refine_background_matrix(st, h, m);
+    if (!invert3(m, m_inv)) return 0;
+    find_background(a, b, w, hh, (uint8_t *)(void *)st->sampled, mask);
+    /* the pixels h and its inverse keep inside the frame: the predictions need both */
+    for (y = BORDER; y < hh - BORDER; y++)
+        for (x = BORDER; x < w - BORDER; x++) {
+            const ptrdiff_t p = (ptrdiff_t)y * w + x;
+            double u, v;
+            if (!mask[p]) continue;
+            mask[p] = apply(m, x, y, &u, &v) && u >= 0.0 && v >= 0.0 && u <= w - 1 &&
+                      v <= hh - 1 && apply(m_inv, x, y, &u, &v) && u >= 0.0 && v >= 0.0 &&
+                      u <= w - 1 && v <= hh - 1;
+            n += mask[p];
+        }
+    if (n * MIN_SHARE < (long)w * hh) return 0;
+    /* the median of r = B - A (sixteenths, within +-4095): its grey level, then its sixteenth */
+    memset(hist, 0, sizeof hist);
+    for (i = 0; i < w * hh; i++)
+        if (mask[i]) hist[((int)b[i] - (int)a[i] + 4096) >> 4]++;
+    half = (int)(n / 2);
+    for (j = 0, cum = 0; j < 511 && cum + hist[j] <= half; j++) cum += hist[j];
+    memset(fine, 0, sizeof fine);
+    for (i = 0; i < w * hh; i++) {
+        const int v = (int)b[i] - (int)a[i] + 4096;
+        if (mask[i] && v >> 4 == j) fine[v & 15]++;
+    }
+    for (f = 0; f < 15 && cum + fine[f] <= half; f++) cum += fine[f];
+    *median = 16 * j + f - 4096;
+    memset(hist, 0, sizeof hist);
+    for (i = 0; i < w * hh; i++) {
+        double d;
+        if (!mask[i]) continue;
+        d = fabs((int)b[i] - (int)a[i] - *median) * 2.0;
+        hist[d < HIST_BINS ? (int)d : HIST_BINS]++;
+    }
+    for (i = 0, cum = 0; i < HIST_BINS && cum + hist[i] <= half; i++) cum += hist[i];
+    *mad = 1.4826 * (i + 0.5) / 2.0;
+    if (*mad < 1.0) *mad = 1.0;
+    return n;
+}
+
+int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
+                                  const double *h, double *observed, double *expected,
+                                  double *evidence)
+{
+    const home__refine_state *st = &ctx->refine;
+    const int w = st->background_w, hh = st->background_h;
+    int16_t *sa = st->sampled, *sb = st->smoothed_b;
+    uint8_t *mask = st->flat;
+    int x, y, j;
+    double m[9], m_inv[9], e_raw, spread, median, mad, sigma2, norm, rp, pp, rr, lo, hi;
+    score_sums k;
+    *observed = *expected = *evidence = 0.0;
+    if (!prepare(st, a, b, h, m, m_inv, &median, &mad)) return 0;
+    lo = median - REJECT_SIGMAS * mad;
+    hi = median + REJECT_SIGMAS * mad;
+    smooth(a, w, hh, sa);
+    smooth(b, w, hh, sb);
+    memset(&k, 0, sizeof k);
+    for (y = BORDER; y < hh - BORDER; y++)
+        for (x = BORDER; x < w - BORDER; x++) {
+            const ptrdiff_t p = (ptrdiff_t)y * w + x;
+            double dx, dy, v[N_V], av, ua, va, ub, vb, pred_a, pred_b;
+            if (!mask[p]) continue;
+            v[V_R] = (int)b[p] - (int)a[p];
+            if (v[V_R] < lo || v[V_R] > hi) continue;
+            apply(m, x, y, &ub, &vb);
+            apply(m_inv, x, y, &ua, &va);
+            dx = ub - x;
+            dy = vb - y;
+            /* the prediction p = -grad . d from A and from B smoothed (central differences) */
+            v[V_PA] = -0.5 * ((sa[p + 1] - sa[p - 1]) * dx + (sa[p + w] - sa[p - w]) * dy);
+            v[V_PB] = -0.5 * ((sb[p + 1] - sb[p - 1]) * dx + (sb[p + w] - sb[p - w]) * dy);
+            /* what r would be under h, from A alone (A at h^-1(x) - A(x)) and from B alone
+             * (B(x) - B at h(x)): exact where the background's detail is finer than d */
+            sample16(a, w, hh, ua, va, &pred_a);
+            sample16(b, w, hh, ub, vb, &pred_b);
+            v[V_QA] = pred_a - a[p];
+            v[V_QB] = b[p] - pred_b;
+            v[V_P] = 0.5 * (v[V_PA] + v[V_PB]);
+            av = a[p];
+            k.n += 1.0;
+            k.a += av;
+            k.aa += av * av;
+            for (j = 0; j < N_V; j++) {
+                k.s[j] += v[j];
+                k.sa[j] += v[j] * av;
+            }
+            k.rr += v[V_R] * v[V_R];
+            k.rp += v[V_R] * v[V_P];
+            k.pp += v[V_P] * v[V_P];
+            k.qapb += v[V_QA] * v[V_PB];
+            k.qbpa += v[V_QB] * v[V_PA];
+            {
+                const double t = 0.5 * (v[V_QA] * v[V_PB] + v[V_QB] * v[V_PA]);
+                k.e += t;
+                k.ee += t * t;
+            }
+        }
+    if (k.n * MIN_SHARE < (double)w * hh) return 0;
+    rp = projected(&k, k.rp, V_R, V_P);
+    pp = projected(&k, k.pp, V_P, V_P);
+    rr = projected(&k, k.rr, V_R, V_R);
+    if (!(pp > 0.0)) return 0;
+    /* the noise: what r keeps after the constant, A and p */
+    sigma2 = (rr - rp * rp / pp) / (k.n - 3.0);
+    if (!(sigma2 > 0.0)) return 0;
+    norm = sqrt(sigma2 * pp);
+    *observed = rp / norm;
+    e_raw = 0.5 * (projected(&k, k.qapb, V_QA, V_PB) + projected(&k, k.qbpa, V_QB, V_PA));
+    *expected = e_raw / norm;
+    spread = k.ee - k.e * k.e / k.n;
+    *evidence = spread > 0.0 ? e_raw / sqrt(spread) : 0.0;
+    return 1;
+}
