@@ -263,14 +263,20 @@ void test_textured_mover_never_steers(void)
     CHECK(identities >= 1);
 }
 
-/* Frames A and B of a static camera on a horizon in fog with a structured object over a fifth
- * of the frame, moved by h_obj in B; noise of shared_sigma the same in both frames (as in the
- * blocks an encoder leaves unchanged), of own_sigma new in each. */
-static void fog_with_object(int config, const double *h_obj, double dx, double dy, double ox,
-                            double oy, double shared_sigma, double own_sigma)
+/* A static camera on a horizon in fog with a structured object over a fifth of the frame,
+ * moving (6, 3) px and turning 0.03 rad in B; noise of shared_sigma the same in both frames (as
+ * in the blocks an encoder leaves unchanged), of own_sigma new in each. Registered with the
+ * mover configuration config into res: never the object's motion as ok. 0 if no context. */
+static int register_fog_mover(int config, double shared_sigma, double own_sigma,
+                              home_result *res)
 {
     static uint8_t object[IMG_W * IMG_H];
+    const double ox = 470.0, oy = 110.0, dx = 6.0, dy = 3.0;
+    home_context *ctx = mover_context(config);
+    double h_obj[9];
     int pass;
+    if (!ctx) return 0;
+    turn_and_shift(0.03, ox, oy, dx, dy, h_obj);
     for (pass = 0; pass < 2; pass++) {
         uint8_t *out = pass ? img_b : img_a;
         synth_rng shared, own;
@@ -291,55 +297,37 @@ static void fog_with_object(int config, const double *h_obj, double dx, double d
                 out[y * IMG_W + x] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v + 0.5);
             }
     }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, res), HOME_OK);
+    print_mover_result(config, res, synth_corner_error(res->H, identity, IMG_W, IMG_H));
+    if (res->ok) CHECK_EQ_INT(res->model, HOME_MODEL_IDENTITY);
+    return 1;
 }
 
-/* A static camera on a horizon in fog with a structured object over a fifth of the frame,
- * moving and turning: every textured region is the object's, and the fog's are too faint for a
- * clear vote of their own. Part of the background's noise is the same in both frames, part is
- * new, so the fog leans to the identity everywhere and decides nowhere alone; all its pixels
- * together do. Never the object's motion, and the identity with both presets when the model is
- * capped at a similarity. */
+/* Every textured region is the object's, and the fog's are too faint for a clear vote of their
+ * own. Part of the background's noise is the same in both frames, part is new, so the fog leans
+ * to the identity everywhere and decides nowhere alone; all its pixels together do: the
+ * identity with both presets when the model is capped at a similarity. */
 void test_static_fog_is_identity(void)
 {
-    const double ox = 470.0, oy = 110.0, dx = 6.0, dy = 3.0;
-    double h_obj[9];
     int config, identities = 0;
-    turn_and_shift(0.03, ox, oy, dx, dy, h_obj);
     for (config = 0; config < 4; config++) {
-        home_context *ctx = mover_context(config);
         home_result res;
-        double err;
-        if (!ctx) { CHECK(0); return; }
-        fog_with_object(config, h_obj, dx, dy, ox, oy, 2.5, 2.0);
-        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
-        err = synth_corner_error(res.H, identity, IMG_W, IMG_H);
-        print_mover_result(config, &res, err);
-        if (res.ok) CHECK_EQ_INT(res.model, HOME_MODEL_IDENTITY);
+        if (!register_fog_mover(config, 2.5, 2.0, &res)) { CHECK(0); return; }
         identities += res.ok && res.model == HOME_MODEL_IDENTITY;
     }
     CHECK(identities >= 2);
 }
 
 /* The same with a live camera's raw frames: all the noise new in each. Two frames hold too
- * little evidence to call the scene static, but the fog's ridge would show the object's motion
- * and does not: never that motion as ok, with any preset (the video preset capped at a
- * similarity returned it, 6.5 px off, before the still-background test). */
+ * little evidence to call the scene static, but the fog would show the object's motion and
+ * does not: never that motion as ok, with any preset (the video preset capped at a similarity
+ * returned it, 6.5 px off, before the still-background test). */
 void test_raw_fog_never_moves(void)
 {
-    const double ox = 470.0, oy = 110.0, dx = 6.0, dy = 3.0;
-    double h_obj[9];
     int config, refused = 0;
-    turn_and_shift(0.03, ox, oy, dx, dy, h_obj);
     for (config = 0; config < 4; config++) {
-        home_context *ctx = mover_context(config);
         home_result res;
-        double err;
-        if (!ctx) { CHECK(0); return; }
-        fog_with_object(config, h_obj, dx, dy, ox, oy, 0.0, 2.0);
-        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
-        err = synth_corner_error(res.H, identity, IMG_W, IMG_H);
-        print_mover_result(config, &res, err);
-        if (res.ok) CHECK_EQ_INT(res.model, HOME_MODEL_IDENTITY);
+        if (!register_fog_mover(config, 0.0, 2.0, &res)) { CHECK(0); return; }
         refused += res.refine_status == HOME_REFINE_STILL_BACKGROUND;
     }
     /* the rules before it refuse the others; this one is the still-background test's */
