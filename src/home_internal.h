@@ -312,6 +312,9 @@ int home__solve_spd(double *a, double *b, int k);
 /* p (h0..h7 of a matrix with h8 = 1) -> the same of its inverse transpose; 0 when singular */
 int home__inverse_transpose8(const double *p, double *out);
 
+/* common.c: the cofactor matrix c of the 3x3 matrix m (row major; m^-1 = c^T / det m) */
+void home__cofactors3(const double *m, double *c);
+
 /* refine.c */
 void home__refine_defaults(home_config *cfg);
 int home__refine_validate(const home_config *cfg);

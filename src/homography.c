@@ -21,16 +21,10 @@ static double det3(const double *m)
 static int inverse_transpose(const double *m, double *out)
 {
     double d = det3(m);
+    int k;
     if (!(fabs(d) > 1e-300) || !isfinite(d)) return 0;
-    out[0] = (m[4] * m[8] - m[5] * m[7]) / d;
-    out[1] = -(m[3] * m[8] - m[5] * m[6]) / d;
-    out[2] = (m[3] * m[7] - m[4] * m[6]) / d;
-    out[3] = -(m[1] * m[8] - m[2] * m[7]) / d;
-    out[4] = (m[0] * m[8] - m[2] * m[6]) / d;
-    out[5] = -(m[0] * m[7] - m[1] * m[6]) / d;
-    out[6] = (m[1] * m[5] - m[2] * m[4]) / d;
-    out[7] = -(m[0] * m[5] - m[2] * m[3]) / d;
-    out[8] = (m[0] * m[4] - m[1] * m[3]) / d;
+    home__cofactors3(m, out);
+    for (k = 0; k < 9; k++) out[k] /= d;
     return 1;
 }
 

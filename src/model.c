@@ -121,15 +121,7 @@ int home__inverse_transpose8(const double *p, double *out)
     const double m[9] = {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], 1.0};
     double c[9], d;
     int k;
-    c[0] = m[4] * m[8] - m[5] * m[7];
-    c[1] = -(m[3] * m[8] - m[5] * m[6]);
-    c[2] = m[3] * m[7] - m[4] * m[6];
-    c[3] = -(m[1] * m[8] - m[2] * m[7]);
-    c[4] = m[0] * m[8] - m[2] * m[6];
-    c[5] = -(m[0] * m[7] - m[1] * m[6]);
-    c[6] = m[1] * m[5] - m[2] * m[4];
-    c[7] = -(m[0] * m[5] - m[2] * m[3]);
-    c[8] = m[0] * m[4] - m[1] * m[3];
+    home__cofactors3(m, c);
     d = c[8];
     if (!(fabs(d) > 1e-12) || !isfinite(d)) return 0;
     for (k = 0; k < 8; k++) out[k] = c[k] / d;

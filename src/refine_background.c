@@ -121,18 +121,13 @@ static int sample16(const uint16_t *img, int w, int h, double u, double v, doubl
 /* The inverse of the 3x3 matrix m into inv; 0 when singular. */
 static int invert3(const double *m, double *inv)
 {
-    const double c0 = m[4] * m[8] - m[5] * m[7], c1 = m[5] * m[6] - m[3] * m[8];
-    const double c2 = m[3] * m[7] - m[4] * m[6], det = m[0] * c0 + m[1] * c1 + m[2] * c2;
+    double c[9], det;
+    int i, j;
+    home__cofactors3(m, c);
+    det = m[0] * c[0] + m[1] * c[1] + m[2] * c[2];
     if (!(fabs(det) > 1e-12)) return 0;
-    inv[0] = c0 / det;
-    inv[1] = (m[2] * m[7] - m[1] * m[8]) / det;
-    inv[2] = (m[1] * m[5] - m[2] * m[4]) / det;
-    inv[3] = c1 / det;
-    inv[4] = (m[0] * m[8] - m[2] * m[6]) / det;
-    inv[5] = (m[2] * m[3] - m[0] * m[5]) / det;
-    inv[6] = c2 / det;
-    inv[7] = (m[1] * m[6] - m[0] * m[7]) / det;
-    inv[8] = (m[0] * m[4] - m[1] * m[3]) / det;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) inv[3 * i + j] = c[3 * j + i] / det;
     return 1;
 }
 

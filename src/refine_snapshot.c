@@ -364,45 +364,47 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
     for (; n % LANES; n++) out->x[n] = out->y[n] = out->t[n] = 0;
 }
 
-/* The slot's background image from the pyramid (box means of f x f, rounded). */
+/* Sum of the side x side box of a level image at p. */
+static long box_sum(const uint8_t *p, int stride, int side)
+{
+    long sum = 0;
+    int i, j;
+    for (j = 0; j < side; j++)
+        for (i = 0; i < side; i++) sum += p[(ptrdiff_t)j * stride + i];
+    return sum;
+}
+
+/* The slot's background images from the pyramid: box means of f x f at the background level,
+ * rounded, and the same boxes from the finer level in sixteenths (the score test's evidence is
+ * below a grey level at quarter size). */
 static void store_background(home__refine_state *st, int slot)
 {
     const int f = st->background_factor, l = st->background_level;
     const int w = st->background_w, h = st->background_h, stride = st->w[l];
-    int x, y, i, j;
+    const int src = l > st->base_level ? l - 1 : l, g = f << (l - src), src_stride = st->w[src];
+    int x, y;
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            const uint8_t *p = st->pyr[l] + (ptrdiff_t)(y * f) * stride + x * f;
-            int sum = 0;
-            for (j = 0; j < f; j++)
-                for (i = 0; i < f; i++) sum += p[(ptrdiff_t)j * stride + i];
+            const long sum = box_sum(st->pyr[l] + (ptrdiff_t)(y * f) * stride + x * f, stride, f);
             st->background[slot][(ptrdiff_t)y * w + x] = (uint8_t)((sum + f * f / 2) / (f * f));
         }
-    /* the same boxes from the finer level, in sixteenths: the score test's evidence is below
-       a grey level at quarter size */
-    {
-        const int src = l > st->base_level ? l - 1 : l, g = f << (l - src);
-        const int src_stride = st->w[src];
-        if (g == 2) {   /* the usual case: 16 x the mean of 2 x 2 is 4 x their sum, exactly */
-            for (y = 0; y < h; y++) {
-                const uint8_t *r0 = st->pyr[src] + (ptrdiff_t)(2 * y) * src_stride;
-                const uint8_t *r1 = r0 + src_stride;
-                uint16_t *o = st->background16[slot] + (ptrdiff_t)y * w;
-                for (x = 0; x < w; x++)
-                    o[x] = (uint16_t)(4 * (r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1]));
-            }
-            return;
+    if (g == 2) {   /* the usual case: 16 x the mean of 2 x 2 is 4 x their sum, exactly */
+        for (y = 0; y < h; y++) {
+            const uint8_t *r0 = st->pyr[src] + (ptrdiff_t)(2 * y) * src_stride;
+            const uint8_t *r1 = r0 + src_stride;
+            uint16_t *o = st->background16[slot] + (ptrdiff_t)y * w;
+            for (x = 0; x < w; x++)
+                o[x] = (uint16_t)(4 * (r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1]));
         }
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                const uint8_t *p = st->pyr[src] + (ptrdiff_t)(y * g) * src_stride + x * g;
-                long sum = 0;
-                for (j = 0; j < g; j++)
-                    for (i = 0; i < g; i++) sum += p[(ptrdiff_t)j * src_stride + i];
-                st->background16[slot][(ptrdiff_t)y * w + x] =
-                    (uint16_t)((16 * sum + g * g / 2) / (g * g));
-            }
+        return;
     }
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            const long sum =
+                box_sum(st->pyr[src] + (ptrdiff_t)(y * g) * src_stride + x * g, src_stride, g);
+            st->background16[slot][(ptrdiff_t)y * w + x] =
+                (uint16_t)((16 * sum + g * g / 2) / (g * g));
+        }
 }
 
 /* The selection's block cells, in the scratch after a row of int16 */
