@@ -139,8 +139,8 @@ typedef struct app {
 static const char *status_name(int s)
 {
     static const char *names[] = {"first", "ok", "failed", "implausible", "cut",
-                                  "still"};
-    return s >= 0 && s < 6 ? names[s] : "?";
+                                  "still", "restored"};
+    return s >= 0 && s < (int)(sizeof names / sizeof names[0]) ? names[s] : "?";
 }
 
 /* Copy the planes of a (w x h) frame into the left or right half of a 2w-wide frame. */

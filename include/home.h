@@ -246,9 +246,18 @@ enum home_refine_status {
     HOME_REFINE_STATIC,           /* a motion most of the frame's regions do not share
                                      (moving objects), or one within 2 sigma_px of the
                                      identity: H is the identity */
-    HOME_REFINE_STILL_BACKGROUND  /* the frame's plain background (fog, a flat wall) stays
+    HOME_REFINE_STILL_BACKGROUND, /* the frame's plain background (fog, a flat wall) stays
                                      where the motion would move it: the moving objects'
-                                     motion, not ok (HOME_FAIL_INCONSISTENT) */
+                                     motion (or the camera's, with a plain occluder such as a
+                                     hand at the lens standing still), not ok
+                                     (HOME_FAIL_INCONSISTENT) */
+    HOME_REFINE_BACKGROUND_MOVES, /* the plain background does not move as the motion would
+                                     move it, nor stands still: a third motion (a textured
+                                     object's, with the camera moving), not ok
+                                     (HOME_FAIL_INCONSISTENT) */
+    HOME_REFINE_STILL_REGIONS     /* a tenth of the regions that clearly decide prefer the
+                                     identity: a part of the frame stands still while the
+                                     motion moves the rest, not ok (HOME_FAIL_INCONSISTENT) */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */
@@ -308,14 +317,17 @@ typedef struct home_result {
  * 8x6 grid explain worse than the identity does (each region votes with its own strongest
  * points, so textured moving objects cannot outvote a plainer background), becomes the
  * identity (HOME_REFINE_STATIC). One the identity clearly explains better in a tenth of the
- * clearly decided regions is two motions, not ok (HOME_FAIL_INCONSISTENT); so is HOME's kept
+ * clearly decided regions is two motions, not ok (HOME_REFINE_STILL_REGIONS,
+ * HOME_FAIL_INCONSISTENT); so is HOME's kept
  * estimate when the refinement converged ill-conditioned more than 2 predicted errors (both
  * estimates') away from it. The plain background judges pixel by pixel: a motion becomes the
  * identity when the plain regions (no textured block) outnumber the textured regions that prefer
  * it and their flat pixels prefer the identity at z >= 6; and it is not ok
  * (HOME_REFINE_STILL_BACKGROUND, HOME_FAIL_INCONSISTENT) when the frame's background away from
  * texture would show it clearly (a z score of 5, spread over the background) and shows less
- * than a third of it: textured objects moving over fog or a flat wall. */
+ * than a third of it: textured objects moving over fog or a flat wall. The refusal's
+ * refine_status says whether that background stands still (STILL_BACKGROUND: its own
+ * translation below 0.4 of the motion's) or moves otherwise (BACKGROUND_MOVES). */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 

@@ -14,7 +14,10 @@
  * identity. A still camera stays still: a motion among frames that register as the identity (at
  * least 2 of the 4 nearest, up to 2 of them ahead within the lookahead, and no other motion
  * among them) is taken as none, unless it moves the corners by more than 2 % of the half
- * diagonal (a knocked tripod).
+ * diagonal (a knocked tripod). A moving camera keeps moving: a motion HOME refused because the
+ * plain background stood still (HOME_REFINE_STILL_BACKGROUND: a hand at the lens) is taken when
+ * at least 2 of the 8 frames before it and up to 2 after it register a motion and none the
+ * identity (a tripod shot's objects over fog are refused alike, among still frames).
  *
  * Scene cuts: a frame that cannot be registered to its predecessor and whose coarse luma (16x16
  * cell means) correlates below 0.5 with the predecessor's at every shift up to max_shift, once
@@ -118,8 +121,12 @@ enum home_stab_motion_status {
     HOME_STAB_MOTION_FAILED,    /* HOME found no trustworthy H: held (no motion) */
     HOME_STAB_MOTION_IMPLAUSIBLE, /* H outside the configured limits: held (no motion) */
     HOME_STAB_MOTION_CUT,       /* a scene cut (or home_stab_cut()): the path restarts here */
-    HOME_STAB_MOTION_STILL      /* a small motion among frames registered as the identity (a
+    HOME_STAB_MOTION_STILL,     /* a small motion among frames registered as the identity (a
                                    still camera): taken as none */
+    HOME_STAB_MOTION_RESTORED   /* a motion HOME refused because the frame's plain background
+                                   stood still, taken because the frames around it register a
+                                   moving camera (a plain part moving with the camera: a hand at
+                                   the lens, blocks an encoder left unchanged) */
 };
 
 /* A similarity about the image centre c: p -> exp(log_scale) R(angle) (p - c) + c + (tx, ty). */

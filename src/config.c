@@ -51,6 +51,8 @@ const char *home_refine_status_name(int status)
     case HOME_REFINE_LESS_PRECISE: return "less_precise";
     case HOME_REFINE_STATIC: return "static";
     case HOME_REFINE_STILL_BACKGROUND: return "still_background";
+    case HOME_REFINE_BACKGROUND_MOVES: return "background_moves";
+    case HOME_REFINE_STILL_REGIONS: return "still_regions";
     default: return "unknown";
     }
 }

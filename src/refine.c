@@ -50,6 +50,10 @@
 #define BACKGROUND_EVIDENCE 5.0 /* ... and one the background would show at this z score, but
                                    does not show at a third of it (refine_background.c; tuning
                                    set: docs/trust.md) */
+#define STILL_SHARE 0.4      /* ... which stands still (the refusal's refine_status) when its
+                                own translation is below this share of the motion's: tuning
+                                set, a hand at the lens 0.13-0.27, blocks an encoder left 0.09-
+                                0.18, the background behind a textured object 0.55-1.75 */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
                                  without HOME's confirmation, the tuning set's wrong refined
@@ -81,6 +85,25 @@ static int same_optimum(home_context *ctx, int slot, const double *start,
     home__refine_run(ctx, slot, mid, &check);
     if (tolerance < SAME_OPTIMUM_FLOOR_PX) tolerance = SAME_OPTIMUM_FLOOR_PX;
     return check.refined && corner_distance(ctx, check.H, refined->H) <= tolerance;
+}
+
+/* A motion refused because a part of the frame stands still becomes the rest's: refined again
+ * without the regions the identity explains better (still: a still occluder, a hand at the
+ * lens, drags a fit of the whole frame). Not ok all the same: the motion a caller that knows
+ * the camera moves (the stabiliser) may take. */
+static void refit_rest(home_context *ctx, int slot, const unsigned char *still, home_result *trial)
+{
+    home_result rest = *trial;
+    int r, any = 0;
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++) any |= still[r];
+    if (!any) return;
+    rest.refined = 0;
+    home__refine_run_without(ctx, slot, trial->H, still, &rest);
+    if (rest.refined) {
+        memcpy(trial->H, rest.H, sizeof trial->H);
+        trial->model = rest.model;
+        trial->sigma_px = rest.sigma_px;
+    }
 }
 
 static int find_slot(const home__refine_state *st, uint32_t id)
@@ -177,10 +200,12 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         const int within_sigma =
             isfinite(trial.sigma_px) && d_identity <= IDENTITY_SIGMAS * trial.sigma_px;
         int against = 0;
-        double observed, expected, evidence;
+        unsigned char still_regions[REGIONS_X * REGIONS_Y] = {0};
+        double observed, expected, evidence, own_motion;
         share = clear_share = 0.0;
         if (!within_sigma)
-            share = home__refine_identity_share(ctx, slot, trial.H, &clear_share, &against);
+            share = home__refine_identity_share(ctx, slot, trial.H, &clear_share, &against,
+                                                still_regions);
         /* the plain regions, when their pixels show the identity, outweigh the textured regions
          * that prefer the motion (the background wins by area: a flat occluder in front of
          * the lens moves with the camera and covers less) */
@@ -190,8 +215,12 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             memcpy(trial.H, home__refine_identity, sizeof trial.H);
             trial.model = HOME_MODEL_IDENTITY;
             trial.refine_status = HOME_REFINE_STATIC;
-        } else if (clear_share >= TWO_MOTIONS_SHARE ||
-                   (trial.refine_status == HOME_REFINE_ILL_CONDITIONED && apart > APART_SIGMAS)) {
+        } else if (clear_share >= TWO_MOTIONS_SHARE) {
+            /* ... or a part of the frame clearly stands still: two motions */
+            trial.ok = 0;
+            trial.failure = HOME_FAIL_INCONSISTENT;
+            trial.refine_status = HOME_REFINE_STILL_REGIONS;
+        } else if (trial.refine_status == HOME_REFINE_ILL_CONDITIONED && apart > APART_SIGMAS) {
             /* ... or, HOME's estimate kept, the frame's own optimum (uncertain as it is) lies
              * farther from it than both predicted errors allow (static fog with moving objects:
              * HOME's lines 1-1.5 px off, the optimum 4-8 px away): neither can be vouched for */
@@ -199,14 +228,20 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             trial.failure = HOME_FAIL_INCONSISTENT;
         } else if (home__refine_background_score(ctx, st->background16[slot],
                                                  st->background16[st->next_slot ^ 1], trial.H,
-                                                 &observed, &expected, &evidence) &&
+                                                 &observed, &expected, &evidence,
+                                                 &own_motion) &&
                    expected >= BACKGROUND_EVIDENCE && evidence >= BACKGROUND_EVIDENCE &&
                    observed < expected / 3.0) {
             /* ... or the background would show the motion clearly, and shows far less of it
              * than predicted: the moving objects' motion over a still background */
             trial.ok = 0;
             trial.failure = HOME_FAIL_INCONSISTENT;
-            trial.refine_status = HOME_REFINE_STILL_BACKGROUND;
+            if (own_motion >= STILL_SHARE) {
+                trial.refine_status = HOME_REFINE_BACKGROUND_MOVES;
+            } else {
+                trial.refine_status = HOME_REFINE_STILL_BACKGROUND;
+                refit_rest(ctx, slot, still_regions, &trial);
+            }
         }
     }
     *result = trial;

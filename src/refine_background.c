@@ -142,11 +142,13 @@ static int apply(const double *m, double x, double y, double *u, double *v)
 }
 
 /* Sums over the background pixels for inner products with [1, A] projected out. */
-enum { V_R, V_P, V_PA, V_PB, V_QA, V_QB, N_V };
+enum { V_R, V_P, V_PA, V_PB, V_QA, V_QB, V_GX, V_GY, N_V };
 typedef struct score_sums {
     double n, a, aa;
     double s[N_V], sa[N_V];         /* sum of v, of v * A */
     double rr, rp, pp, qapb, qbpa;  /* the inner products used */
+    double xx, xy, yy, rx, ry;      /* ... those of the background's own translation, */
+    double dd;                      /* and h's squared displacements */
     double e, ee;                   /* the expected's terms: sum, sum of squares */
 } score_sums;
 
@@ -213,7 +215,7 @@ static long prepare(const home__refine_state *st, const uint16_t *a, const uint1
 
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
                                   const double *h, double *observed, double *expected,
-                                  double *evidence)
+                                  double *evidence, double *own_motion)
 {
     const home__refine_state *st = &ctx->refine;
     const int w = st->background_w, hh = st->background_h;
@@ -222,7 +224,7 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
     int x, y, j;
     double m[9], m_inv[9], e_raw, spread, median, mad, sigma2, norm, rp, pp, rr, lo, hi;
     score_sums k;
-    *observed = *expected = *evidence = 0.0;
+    *observed = *expected = *evidence = *own_motion = 0.0;
     if (!prepare(st, a, b, h, m, m_inv, &median, &mad)) return 0;
     lo = median - REJECT_SIGMAS * mad;
     hi = median + REJECT_SIGMAS * mad;
@@ -250,6 +252,8 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
             v[V_QA] = pred_a - a[p];
             v[V_QB] = b[p] - pred_b;
             v[V_P] = 0.5 * (v[V_PA] + v[V_PB]);
+            v[V_GX] = 0.25 * ((sa[p + 1] - sa[p - 1]) + (sb[p + 1] - sb[p - 1]));
+            v[V_GY] = 0.25 * ((sa[p + w] - sa[p - w]) + (sb[p + w] - sb[p - w]));
             av = a[p];
             k.n += 1.0;
             k.a += av;
@@ -263,6 +267,12 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
             k.pp += v[V_P] * v[V_P];
             k.qapb += v[V_QA] * v[V_PB];
             k.qbpa += v[V_QB] * v[V_PA];
+            k.xx += v[V_GX] * v[V_GX];
+            k.xy += v[V_GX] * v[V_GY];
+            k.yy += v[V_GY] * v[V_GY];
+            k.rx += v[V_R] * v[V_GX];
+            k.ry += v[V_R] * v[V_GY];
+            k.dd += dx * dx + dy * dy;
             {
                 const double t = 0.5 * (v[V_QA] * v[V_PB] + v[V_QB] * v[V_PA]);
                 k.e += t;
@@ -283,5 +293,14 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
     *expected = e_raw / norm;
     spread = k.ee - k.e * k.e / k.n;
     *evidence = spread > 0.0 ? e_raw / sqrt(spread) : 0.0;
+    /* the background's own translation g: least squares of r = -grad . g, against h's RMS
+     * displacement there */
+    {
+        const double xx = projected(&k, k.xx, V_GX, V_GX), xy = projected(&k, k.xy, V_GX, V_GY);
+        const double yy = projected(&k, k.yy, V_GY, V_GY), rx = projected(&k, k.rx, V_R, V_GX);
+        const double ry = projected(&k, k.ry, V_R, V_GY), det = xx * yy - xy * xy;
+        if (det > 0.0 && k.dd > 0.0)
+            *own_motion = hypot(yy * rx - xy * ry, xx * ry - xy * rx) / det / sqrt(k.dd / k.n);
+    }
     return 1;
 }

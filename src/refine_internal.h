@@ -42,6 +42,10 @@ typedef struct home__refine_solver {
     int k;                              /* parameters of the model fitted (8: a homography) */
     double basis[8][8];                 /* the update's subspace dp = B q when k < 8 */
     float *img_b, *img_b2, *res, *wt;   /* per-point scratch */
+    const unsigned char *excluded;      /* per region of the identity test's grid: its points
+                                           take no part where nonzero (NULL: every point
+                                           does) */
+    int mask_level;                     /* the level img_b2 holds the points' mask for */
 } home__refine_solver;
 
 extern const double home__refine_identity[9];
@@ -81,12 +85,17 @@ double home__refine_max_corner_distance(double cx, double cy, const double *h1,
  * the optimum lies from h0 in units of both estimates' predicted errors (result->sigma_px on
  * entry is h0's); else 0. */
 double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result);
+/* The same without the points of the regions excluded flags (the identity test's grid): the
+ * motion of the rest of the frame. */
+double home__refine_run_without(home_context *ctx, int slot, const double *h0,
+                                const unsigned char *excluded, home_result *result);
 
 /* refine_static.c */
 /* h (full-size pixels) as a map of background pixels, into m. */
 void home__refine_background_matrix(const home__refine_state *st, const double *h, double *m);
+/* still (optional, REGIONS_X * REGIONS_Y): 1 for the regions the identity explains better. */
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,
-                                   double *clear_share, int *against);
+                                   double *clear_share, int *against, unsigned char *still);
 /* Regions of frame A with no block above the textured floor (faint or flat). */
 int home__refine_plain_regions(const home_context *ctx, int slot);
 /* How much better the identity than h (pixels) explains frame A's plain regions (no block
@@ -101,10 +110,13 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
  * (background16 images: refine.background_w x background_h) at the pixels away from texture.
  * observed: the identity's residual projected on the one h predicts, over its noise (about
  * N(0, 1) if the background stands still); expected: the same if h were the background's
- * motion; evidence: expected over the spread of its per-pixel terms. Returns 0 (all 0) when
- * there is too little background or no refinement. Uses the match-time scratch. */
+ * motion; evidence: expected over the spread of its per-pixel terms; own_motion: the
+ * translation the background shows by itself (least squares on its gradient) over h's RMS
+ * displacement there (about 0 if it stands still, below 1 if a part of it moves with h, large
+ * if it moves otherwise). Returns 0 (all 0) when there is too little background or no
+ * refinement. Uses the match-time scratch. */
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
                                   const double *h, double *observed, double *expected,
-                                  double *evidence);
+                                  double *evidence, double *own_motion);
 
 #endif

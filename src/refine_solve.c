@@ -220,7 +220,16 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
                       st->h[level], s->img_b);
     s->sigma = home__refine_robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta,
                                          (int32_t *)(void *)s->wt);
-    valid = home__refine_fit_photometric(s, tp, s->img_b, NULL, s->sigma, s->res, s->wt);
+    if (s->excluded && s->mask_level != level) {
+        /* the points of excluded regions as outside the frame (img_b2 is free while solving) */
+        for (i = 0; i < n4; i++)
+            s->img_b2[i] = i < tp->n && s->excluded[region_of(tp->x[i], tp->y[i], st->w[level],
+                                                              st->h[level])]
+                               ? -1.0f : 0.0f;
+        s->mask_level = level;
+    }
+    valid = home__refine_fit_photometric(s, tp, s->img_b, s->excluded ? s->img_b2 : NULL,
+                                         s->sigma, s->res, s->wt);
     if (valid < MIN_POINTS) return 0;
     aff[0] = (float)(sc / s->f);
     aff[1] = (float)((o - s->cx) / s->f);
@@ -516,6 +525,7 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
     s->wt = scratch + 3 * cap;
     s->alpha = 1.0;
     s->hessian_level = -1;
+    s->mask_level = -1;
     s->k = 8;
     for (s->finest = st->finest_level; s->finest < st->levels - 1; s->finest++) {
         const int cap_half = s->tpl[s->finest].capacity / 2;
@@ -524,9 +534,11 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
     }
 }
 
-/* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid.
- * Writes the refined H and fills the refine fields of result. */
-double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)
+/* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
+ * without the points of the excluded regions (NULL: none). Writes the refined H and fills the
+ * refine fields of result. */
+static double refine_run(home_context *ctx, int slot, const double *h0,
+                         const unsigned char *excluded, home_result *result)
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
@@ -537,6 +549,7 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, home_resu
         MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
 
     home__refine_solver_setup(ctx, slot, &s);
+    s.excluded = excluded;
     /* below a homography the update stays in the model (it is a group: I + D(dp) in it keeps
      * the estimate in it), so a few edges that leave a homography undetermined still fix it */
     s.k = 8;
@@ -609,6 +622,12 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, home_resu
         st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
         home__refine_level_matrix(&s, hn0, fl, m);
         st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
+        if (excluded) {
+            int i;
+            for (i = 0; i < tp->n; i++)
+                if (excluded[region_of(tp->x[i], tp->y[i], st->w[fl], st->h[fl])])
+                    s.img_b[i] = s.img_b2[i] = -1.0f;
+        }
         s.alpha = 1.0;
         s.beta = 0.0;
         home__refine_fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
@@ -636,4 +655,15 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, home_resu
     result->refined = 1;
     result->refine_status = HOME_REFINE_ACCEPTED;
     return 0.0;
+}
+
+double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)
+{
+    return refine_run(ctx, slot, h0, NULL, result);
+}
+
+double home__refine_run_without(home_context *ctx, int slot, const double *h0,
+                                const unsigned char *excluded, home_result *result)
+{
+    return refine_run(ctx, slot, h0, excluded, result);
 }

@@ -31,7 +31,7 @@
  * textured and draw the template points (and HOME's lines) to themselves; the static
  * background wins by area. */
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,
-                                    double *clear_share, int *against)
+                                    double *clear_share, int *against, unsigned char *still)
 {
     const home__refine_state *st = &ctx->refine;
     double cost[2][2][REGIONS_X * REGIONS_Y], gain[2], bias[2], hn[9], sigma, c, cost_h, cost_i;
@@ -43,6 +43,7 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
     home__refine_solver s;
     *clear_share = 0.0;
     *against = 0;
+    if (still) memset(still, 0, REGIONS_X * REGIONS_Y);
     home__refine_solver_setup(ctx, slot, &s);
     fl = st->region_level;
     tp = &st->regions[slot];
@@ -92,6 +93,7 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
             votes++;
             wins += cost_i < cost_h;
         }
+        if (still) still[r] = cost_i < cost_h;
         /* a clear vote: at most half the other's cost, and more than a grey level per point
          * apart (near the identity, or on flat regions, the costs tie) */
         if ((cost_i < cost_h ? cost_i : cost_h) >

@@ -21,8 +21,9 @@ void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t s
 #define HOME__STAB_THUMB_SIDE 16
 #define HOME__STAB_THUMB_CELLS (HOME__STAB_THUMB_SIDE * HOME__STAB_THUMB_SIDE)
 
-/* Slots of path history at least (stab_still.c looks at 4 frames before a motion). */
-#define HOME__STAB_MIN_RING 5
+/* Slots of path history at least: stab_still.c looks at up to 8 frames before a motion decided
+ * up to 2 frames late. */
+#define HOME__STAB_MIN_RING 11
 
 /* One frame of path history. Path components are normalised to pixels (angle and log scale
  * times the half diagonal) so that one filter covariance serves all four of them. */
@@ -35,6 +36,9 @@ typedef struct stab_slot {
     double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
     home_stab_sim motion;         /* the motion from the previous frame taken (0 when held) */
     int registered_still;         /* the registration was the identity */
+    int has_candidate;            /* held, refused only because the plain background stood still: */
+    home_stab_sim candidate;      /* the refused motion, plausible, */
+    double candidate_weight;      /* and the weight it would have */
     int smoothed_ready;           /* its segment has ended: `smoothed` is its final path */
     home_stab_sim smoothed;
 } stab_slot;
@@ -85,6 +89,7 @@ home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last);
 /* stab_still.c */
 long home__stab_still_delay(const home_stab *st);
 void home__stab_settle_still(home_stab *st, long t, long newest);
+void home__stab_settle_restored(home_stab *st, long t, long newest);
 
 /* stab_cut.c */
 void home__stab_thumbnail(const uint8_t *luma, ptrdiff_t stride, int w, int h, float *thumb);

@@ -1,8 +1,14 @@
-/* A still camera stays still: a small motion registered between frames that otherwise register
+/* The frames around a motion decide what a doubtful one was.
+ * A still camera stays still: a small motion registered between frames that otherwise register
  * as the identity (a tripod shot, where fog, noise or a passing object can tip one registration
  * of many) is taken as none, so that such motions cannot accumulate into drift. A large motion
  * is kept: a tripod that is knocked moves. With a lookahead the frames after the motion are
- * looked at too, so the first frames of a real start are kept. */
+ * looked at too, so the first frames of a real start are kept.
+ * A moving camera keeps moving: a motion HOME refused only because the frame's plain background
+ * stood still is either a moving object over a still background (a tripod shot: its neighbours
+ * register the identity) or the camera's motion with a plain part moving along (a hand at the
+ * lens, blocks an encoder left unchanged: its neighbours register motions). Among moving
+ * neighbours and no still one it is taken, instead of holding the frame and keeping its shake. */
 #include "stab_internal.h"
 #include <math.h>
 
@@ -14,6 +20,9 @@
  * however lone (a knocked tripod, 7 px at 640x360). Not a multiple of sigma_px: the lone wrong
  * motions of a textured object over a faint background are 10-30 of their own sigma off. */
 #define STILL_KNOCK 0.02
+#define RESTORE_BEFORE 8       /* frames looked at before a refused motion (and up to STILL_AFTER
+                                  after it), */
+#define RESTORE_MIN 2          /* registered moving (ok, not the identity), with none still */
 
 long home__stab_still_delay(const home_stab *st)
 {
@@ -53,18 +62,18 @@ static int is_lone(const home_stab *st, long t, long newest)
     return still >= STILL_MIN && !moved;
 }
 
-/* Decide frame t's motion once the frames up to newest are in: a lone one becomes none, and the
- * path from t on is recomputed and filtered again. */
-void home__stab_settle_still(home_stab *st, long t, long newest)
+/* Frame t's motion becomes m (status, weight): the path from t on is composed and filtered
+ * again up to newest. */
+static void retake_motion(home_stab *st, long t, long newest, const home_stab_sim *m, int status,
+                          double weight)
 {
     const long first = st->first, lookahead = st->cfg.lookahead;
-    stab_slot *s;
+    stab_slot *s = slot_of(st, t);
     long i;
     double z[4];
-    if (t <= first || t < st->emitted || !is_lone(st, t, newest)) return;
-    s = slot_of(st, t);
-    s->motion.tx = s->motion.ty = s->motion.angle = s->motion.log_scale = 0.0;
-    s->status = HOME_STAB_MOTION_STILL;
+    s->motion = *m;
+    s->status = status;
+    s->weight = weight;
     for (i = t; i <= newest; i++)
         slot_of(st, i)->raw = home__stab_sim_compose(&slot_of(st, i)->motion,
                                                      &slot_of(st, i - 1)->raw);
@@ -77,4 +86,34 @@ void home__stab_settle_still(home_stab *st, long t, long newest)
         home__stab_path_components(st, &slot_of(st, i)->raw, z);
         home__stab_kalman_step(st, slot_of(st, i - 1), slot_of(st, i), z);
     }
+}
+
+/* Decide frame t's motion once the frames up to newest are in: a lone one becomes none. */
+void home__stab_settle_still(home_stab *st, long t, long newest)
+{
+    static const home_stab_sim none = {0, 0, 0, 0};
+    if (t <= st->first || t < st->emitted || !is_lone(st, t, newest)) return;
+    retake_motion(st, t, newest, &none, HOME_STAB_MOTION_STILL, slot_of(st, t)->weight);
+}
+
+/* A held frame t with a refused motion among moving neighbours takes that motion. Restored
+ * frames are no evidence for their neighbours, so that one cannot carry the next. */
+void home__stab_settle_restored(home_stab *st, long t, long newest)
+{
+    const long after = newest - t < STILL_AFTER ? newest - t : STILL_AFTER;
+    const stab_slot *s;
+    long i;
+    int still = 0, moved = 0;
+    if (t <= st->first || t < st->emitted) return;
+    s = slot_of(st, t);
+    if (s->frame != t || s->status != HOME_STAB_MOTION_FAILED || !s->has_candidate) return;
+    for (i = t - RESTORE_BEFORE; i <= t + after; i++)
+        if (i != t && i > st->first && slot_of(st, i)->frame == i) {
+            const stab_slot *n = slot_of(st, i);
+            still += n->registered_still || n->status == HOME_STAB_MOTION_STILL;
+            moved += n->status == HOME_STAB_MOTION_OK && !n->registered_still;
+        }
+    if (moved >= RESTORE_MIN && !still)
+        retake_motion(st, t, newest, &s->candidate, HOME_STAB_MOTION_RESTORED,
+                      s->candidate_weight);
 }

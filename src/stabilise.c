@@ -228,8 +228,10 @@ int home_stab_cut(home_stab *st)
 static void end_segment(home_stab *st, long last)
 {
     long t;
-    for (t = last - home__stab_still_delay(st) + 1; t <= last; t++)
+    for (t = last - home__stab_still_delay(st) + 1; t <= last; t++) {
         home__stab_settle_still(st, t, last);
+        home__stab_settle_restored(st, t, last);
+    }
     home__stab_end_segment(st, last);
 }
 
@@ -385,6 +387,26 @@ static void emit(home_stab *st, long last, home_stab_output *out)
     st->emitted++;
 }
 
+/* The similarity of a registration's H when it is within the configured limits (1), with the
+ * weight its predicted error gives it. */
+static int plausible_motion(const home_stab *st, const home_result *reg, home_stab_sim *motion,
+                            double *weight)
+{
+    /* home__stab_fit_similarity() fills s when it returns >= 0 */
+    home_stab_sim s = {0, 0, 0, 0};
+    const double res = home__stab_fit_similarity(st, reg->H, &s);
+    double sigma;
+    if (!(res >= 0.0 && res <= st->cfg.max_residual &&
+          hypot(s.tx, s.ty) <= st->cfg.max_shift * st->cfg.width &&
+          fabs(s.angle) <= st->cfg.max_rotation && fabs(s.log_scale) <= st->cfg.max_zoom))
+        return 0;
+    sigma = reg->sigma_px * st->cfg.downscale;
+    if (!(sigma <= STAB_MAX_SIGMA_PX)) return 0;   /* a refused motion may be undetermined */
+    *motion = s;
+    *weight = 1.0 + (sigma / STAB_SIGMA_REF_PX) * (sigma / STAB_SIGMA_REF_PX);
+    return 1;
+}
+
 static int check_stab(const home_stab *st, const home_stab_output *out)
 {
     if (!st || !out) return HOME_E_NULL;
@@ -396,8 +418,9 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     const uint8_t *luma;
     ptrdiff_t stride;
     home_features *swap;
-    home_stab_sim motion = {0, 0, 0, 0};
-    double weight = 1.0, sigma = 0.0;
+    home_stab_sim motion = {0, 0, 0, 0}, candidate = {0, 0, 0, 0};
+    double weight = 1.0, candidate_weight = 1.0;
+    int has_candidate = 0;
     stab_slot *slot;
     double t0 = 0, z[4];
     long n;
@@ -418,18 +441,11 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
         if (status != HOME_OK) return status;
         out->newest_status = HOME_STAB_MOTION_FAILED;
         if (out->reg.ok) {
-            /* home__stab_fit_similarity() fills s when it returns >= 0 */
-            home_stab_sim s = {0, 0, 0, 0};
-            double res = home__stab_fit_similarity(st, out->reg.H, &s);
             out->newest_status = HOME_STAB_MOTION_IMPLAUSIBLE;
-            if (res >= 0.0 && res <= st->cfg.max_residual &&
-                hypot(s.tx, s.ty) <= st->cfg.max_shift * st->cfg.width &&
-                fabs(s.angle) <= st->cfg.max_rotation && fabs(s.log_scale) <= st->cfg.max_zoom) {
-                sigma = out->reg.sigma_px * st->cfg.downscale;
+            if (plausible_motion(st, &out->reg, &motion, &weight))
                 out->newest_status = HOME_STAB_MOTION_OK;
-                motion = s;
-                weight = 1.0 + (sigma / STAB_SIGMA_REF_PX) * (sigma / STAB_SIGMA_REF_PX);
-            }
+        } else if (out->reg.refine_status == HOME_REFINE_STILL_BACKGROUND) {
+            has_candidate = plausible_motion(st, &out->reg, &candidate, &candidate_weight);
         }
     }
     swap = st->feat[0];
@@ -446,6 +462,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
         out->newest_status = HOME_STAB_MOTION_CUT;
         weight = 1.0;   /* as a stream's first frame */
         memset(&motion, 0, sizeof motion);
+        has_candidate = 0;
     }
     st->cut_requested = 0;
     if (st->cfg.clock) out->ms_register = st->cfg.clock(st->cfg.clock_user) - t0;
@@ -457,6 +474,9 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     slot->motion = motion;
     slot->registered_still = out->newest_status == HOME_STAB_MOTION_OK &&
                              out->reg.model == HOME_MODEL_IDENTITY;
+    slot->has_candidate = has_candidate;
+    slot->candidate = candidate;
+    slot->candidate_weight = candidate_weight;
     slot->smoothed_ready = 0;
     if (n == st->first) {
         memset(&slot->raw, 0, sizeof slot->raw);
@@ -471,6 +491,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     st->pushed = n + 1;
     st->tail = 0;
     home__stab_settle_still(st, n - home__stab_still_delay(st), n);
+    home__stab_settle_restored(st, n - home__stab_still_delay(st), n);
     if (n - st->first == st->cfg.lookahead) home__stab_refilter_mirrored_start(st, st->first, n);
     if (n - st->emitted >= st->cfg.lookahead) emit(st, n, out);
     return HOME_OK;

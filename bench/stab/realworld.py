@@ -679,7 +679,7 @@ def cells(row, key, fmt, best=None):
 
 def registration(stab, clip_y4m, truth, work, extra):
     """home-stab's own registrations (--lookahead 15, its CSV) against the truth, frame to frame:
-    of the frames reported ok or still, the mean corner error and how many are more than 2 px
+    of the frames reported ok, still or restored, the mean corner error and how many are more than 2 px
     off (silent errors); the others are failures. Cuts, blank frames and the first frame are
     not counted."""
     csv_path = work / "registration.csv"
@@ -695,7 +695,7 @@ def registration(stab, clip_y4m, truth, work, extra):
     for k in range(1, min(len(rows), len(g))):
         if k in skip or rows[k]["status"] in ("first", "cut"):
             continue
-        if rows[k]["status"] not in ("ok", "still"):
+        if rows[k]["status"] not in ("ok", "still", "restored"):
             failed += 1
             continue
         path = [camera(float(rows[j]["raw_tx"]), float(rows[j]["raw_ty"]),

@@ -118,7 +118,8 @@ static GstStaticPadTemplate src_template =
 
 static const char *motion_status_name(int status)
 {
-    static const char *names[] = {"first", "ok", "failed", "implausible", "cut", "still"};
+    static const char *names[] = {"first", "ok",    "failed",  "implausible",
+                                  "cut",   "still", "restored"};
     return status >= 0 && status < (int)G_N_ELEMENTS(names) ? names[status] : "unknown";
 }
 

@@ -77,7 +77,8 @@ static void check_output(const home_stab_output *out)
     if (!out->ready) return;
     for (k = 0; k < 9; k++) FZ_CHECK(isfinite(out->warp[k]));
     FZ_CHECK(out->correction_used >= 0.0 && out->correction_used <= 1.0);
-    FZ_CHECK(out->motion_status >= HOME_STAB_MOTION_FIRST && out->motion_status <= HOME_STAB_MOTION_STILL);
+    FZ_CHECK(out->motion_status >= HOME_STAB_MOTION_FIRST &&
+             out->motion_status <= HOME_STAB_MOTION_RESTORED);
     FZ_CHECK(isfinite(out->raw.tx) && isfinite(out->raw.ty) && isfinite(out->smooth.angle));
 }
 
