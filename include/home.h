@@ -255,9 +255,12 @@ enum home_refine_status {
                                      move it, nor stands still: a third motion (a textured
                                      object's, with the camera moving), not ok
                                      (HOME_FAIL_INCONSISTENT) */
-    HOME_REFINE_STILL_REGIONS     /* a tenth of the regions that clearly decide prefer the
+    HOME_REFINE_STILL_REGIONS,    /* a tenth of the regions that clearly decide prefer the
                                      identity: a part of the frame stands still while the
                                      motion moves the rest, not ok (HOME_FAIL_INCONSISTENT) */
+    HOME_REFINE_PERIODIC          /* a repeated pattern: the motion one period along it fits
+                                     about as well, so the pair cannot tell which is right;
+                                     sigma_px at least the period, not ok (HOME_FAIL_UNCERTAIN) */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */
@@ -318,16 +321,20 @@ typedef struct home_result {
  * points, so textured moving objects cannot outvote a plainer background), becomes the
  * identity (HOME_REFINE_STATIC). One the identity clearly explains better in a tenth of the
  * clearly decided regions is two motions, not ok (HOME_REFINE_STILL_REGIONS,
- * HOME_FAIL_INCONSISTENT); so is HOME's kept
- * estimate when the refinement converged ill-conditioned more than 2 predicted errors (both
- * estimates') away from it. The plain background judges pixel by pixel: a motion becomes the
+ * HOME_FAIL_INCONSISTENT); so is HOME's kept estimate when the refinement converged
+ * ill-conditioned more than 2 predicted errors (both estimates') away from it. The plain background judges pixel by pixel: a motion becomes the
  * identity when the plain regions (no textured block) outnumber the textured regions that prefer
  * it and their flat pixels prefer the identity at z >= 6; and it is not ok
  * (HOME_REFINE_STILL_BACKGROUND, HOME_FAIL_INCONSISTENT) when the frame's background away from
  * texture would show it clearly (a z score of 5, spread over the background) and shows less
  * than a third of it: textured objects moving over fog or a flat wall. The refusal's
  * refine_status says whether that background stands still (STILL_BACKGROUND: its own
- * translation below 0.4 of the motion's) or moves otherwise (BACKGROUND_MOVES). */
+ * translation below 0.4 of the motion's) or moves otherwise (BACKGROUND_MOVES).
+ *
+ * Repeated patterns: where frame A repeats along its dominant gradient direction and the
+ * refinement, started one period away either way, reaches an optimum that fits at most 1.75
+ * times worse than the answer, the pair cannot tell the two apart: not ok
+ * (HOME_REFINE_PERIODIC, HOME_FAIL_UNCERTAIN, sigma_px at least the period). */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 

@@ -96,6 +96,11 @@ void home__refine_background_matrix(const home__refine_state *st, const double *
 /* still (optional, REGIONS_X * REGIONS_Y): 1 for the regions the identity explains better. */
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,
                                    double *clear_share, int *against, unsigned char *still);
+/* Mean robust cost of the region points under each of the k motions hs (pixels), each with
+ * its own gain and bias, at the scale of the first one's residuals; INFINITY where a motion is
+ * missing (NULL). */
+void home__refine_region_costs(home_context *ctx, int slot, const double *const *hs, int k,
+                               double *cost);
 /* Regions of frame A with no block above the textured floor (faint or flat). */
 int home__refine_plain_regions(const home_context *ctx, int slot);
 /* How much better the identity than h (pixels) explains frame A's plain regions (no block
@@ -118,5 +123,11 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
                                   const double *h, double *observed, double *expected,
                                   double *evidence, double *own_motion);
+
+/* refine_alias.c: frame A's period (full-size px; 0: none found) and, when there is one, the
+ * mean robust cost of the optimum the refinement reaches from h shifted by one period either
+ * way (the better, if away from h) over h's own, on the identity test's region points
+ * (INFINITY without a period or an alias). Uses the match-time scratch. */
+double home__refine_alias_ratio(home_context *ctx, int slot, const double *h, double *period);
 
 #endif

@@ -108,6 +108,47 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
     return votes >= REGIONS_X * REGIONS_Y / 4 ? (double)wins / votes : 0.0;
 }
 
+void home__refine_region_costs(home_context *ctx, int slot, const double *const *hs, int k,
+                               double *cost)
+{
+    const home__refine_state *st = &ctx->refine;
+    const home__refine_points *tp = &st->regions[slot];
+    const int fl = st->region_level, n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    home__refine_solver s;
+    double sigma = 0.0;
+    int j, i, valid;
+    home__refine_solver_setup(ctx, slot, &s);
+    for (j = 0; j < k; j++) {
+        double hn[9];
+        float m[9];
+        cost[j] = INFINITY;
+        if (!hs[j]) continue;
+        home__refine_to_normalised(&s, hs[j], hn);
+        home__refine_level_matrix(&s, hn, fl, m);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
+        s.alpha = 1.0;
+        s.beta = 0.0;
+        if (j == 0) {
+            home__refine_fit_photometric(&s, tp, s.img_b, NULL, SIGMA_FLOOR * 1e3, s.res, s.wt);
+            sigma = home__refine_robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta,
+                                              (int32_t *)(void *)s.wt);
+            s.alpha = 1.0;
+            s.beta = 0.0;
+        }
+        for (i = 0; i < 2; i++)
+            home__refine_fit_photometric(&s, tp, s.img_b, NULL, sigma, s.res, s.wt);
+        cost[j] = 0.0;
+        valid = 0;
+        for (i = 0; i < tp->n; i++)
+            if (s.img_b[i] >= 0.0f) {
+                cost[j] += robust_cost(s.res[i], CAUCHY_K * sigma);
+                valid++;
+            }
+        /* mean over the points each keeps in the frame */
+        cost[j] = valid ? cost[j] / valid : INFINITY;
+    }
+}
+
 /* Bilinear sample of a level image at (u, v) inside [0, w-1] x [0, h-1]. */
 static double sample(const uint8_t *img, int w, int h, double u, double v)
 {
