@@ -16,42 +16,47 @@
 #define PERIODS_SEEN 3      /* the profile spans at least this many periods */
 
 /* The period of frame A's background (full-size px along the unit vector n), or 0. The
- * profile goes to the match-time scratch (at least 4 REGION_CAPACITY floats). */
+ * profile and its autocorrelation go to the match-time scratch (at least 4 REGION_CAPACITY
+ * floats). */
 static double find_period(const home__refine_state *st, int slot, double *n)
 {
     const uint8_t *a = st->background[slot];
     const int w = st->background_w, h = st->background_h;
     const double sc = (double)((1 << st->background_level) * st->background_factor);
-    float *sum = (float *)st->scratch, *count = sum + PROFILE_BINS;
-    int x, y, lag, bins, best_lag = 0;
-    double sxx = 0.0, syy = 0.0, sxy = 0.0, phi, c, s, span, bin_w, mean = 0.0, best = PERIOD_CORR;
-    long total = 0;
+    float *sum = (float *)st->scratch, *count = sum + PROFILE_BINS, *r = count + PROFILE_BINS;
+    int x, y, lag, bins, max_lag;
+    long sxx = 0, syy = 0, sxy = 0, total = 0;
+    double phi, c, s, span, step, mean = 0.0;
     if (!a || w < 8 || h < 8) return 0.0;
-    for (y = 1; y < h - 1; y++)
+    for (y = 1; y < h - 1; y++) {
+        const uint8_t *p = a + (ptrdiff_t)y * w;
         for (x = 1; x < w - 1; x++) {
-            const uint8_t *p = a + (ptrdiff_t)y * w + x;
-            const double gx = (double)p[1] - p[-1], gy = (double)p[w] - p[-w];
+            const int gx = p[x + 1] - p[x - 1], gy = p[x + w] - p[x - w];
             sxx += gx * gx;
             syy += gy * gy;
             sxy += gx * gy;
         }
-    if (!(sxx + syy > 0.0)) return 0.0;
-    phi = 0.5 * atan2(2.0 * sxy, sxx - syy);
+    }
+    if (!(sxx + syy > 0)) return 0.0;
+    phi = 0.5 * atan2(2.0 * (double)sxy, (double)(sxx - syy));
     c = cos(phi);
     s = sin(phi);
     span = fabs(c) * (w - 1) + fabs(s) * (h - 1);
-    bin_w = span < PROFILE_BINS - 1 ? 1.0 : ceil(span / (PROFILE_BINS - 1));
-    bins = (int)(span / bin_w) + 1;
+    step = span < PROFILE_BINS - 1 ? 1.0 : ceil(span / (PROFILE_BINS - 1));
+    bins = (int)(span / step) + 1;
     memset(sum, 0, 2 * PROFILE_BINS * sizeof *sum);
-    for (y = 0; y < h; y++)
-        for (x = 0; x < w; x++) {
-            const double u = c * (x - 0.5 * (w - 1)) + s * (y - 0.5 * (h - 1)) + 0.5 * span;
-            int b = (int)(u / bin_w + 0.5);
-            if (b < 0) b = 0;
-            if (b >= bins) b = bins - 1;
-            sum[b] += a[(ptrdiff_t)y * w + x];
+    /* bin of pixel (x, y): its position along n from the corner n points away from, in bins */
+    for (y = 0; y < h; y++) {
+        const uint8_t *p = a + (ptrdiff_t)y * w;
+        double u = (c * (0 - 0.5 * (w - 1)) + s * (y - 0.5 * (h - 1)) + 0.5 * span) / step + 0.5;
+        const double du = c / step;
+        for (x = 0; x < w; x++, u += du) {
+            int b = (int)u;
+            b = b < 0 ? 0 : b >= bins ? bins - 1 : b;
+            sum[b] += p[x];
             count[b] += 1.0f;
         }
+    }
     for (x = 0; x < bins; x++)
         if (count[x] >= BIN_MIN_COUNT) {
             sum[x] /= count[x];
@@ -61,30 +66,25 @@ static double find_period(const home__refine_state *st, int slot, double *n)
     if (total < 2) return 0.0;
     mean /= (double)total;
     for (x = 0; x < bins; x++) sum[x] = count[x] >= BIN_MIN_COUNT ? (float)(sum[x] - mean) : 0.0f;
-    /* the first lag whose correlation is a local maximum above PERIOD_CORR */
-    for (lag = PERIOD_MIN; lag * PERIODS_SEEN < bins; lag++) {
-        double r[3];
-        int k;
-        for (k = 0; k < 3; k++) {
-            const int l = lag - 1 + k;
-            double sab = 0.0, saa = 0.0, sbb = 0.0;
-            for (x = 0; x + l < bins; x++) {
-                if (count[x] < BIN_MIN_COUNT || count[x + l] < BIN_MIN_COUNT) continue;
-                sab += (double)sum[x] * sum[x + l];
-                saa += (double)sum[x] * sum[x];
-                sbb += (double)sum[x + l] * sum[x + l];
-            }
-            r[k] = saa > 0.0 && sbb > 0.0 ? sab / sqrt(saa * sbb) : 0.0;
+    /* normalised autocorrelation (bins too thin count as zero), then the first lag from
+     * PERIOD_MIN that is a local maximum of at least PERIOD_CORR */
+    max_lag = (bins - 1) / PERIODS_SEEN;
+    for (lag = PERIOD_MIN - 1; lag <= max_lag + 1; lag++) {
+        double sab = 0.0, saa = 0.0, sbb = 0.0;
+        for (x = 0; x + lag < bins; x++) {
+            sab += (double)sum[x] * sum[x + lag];
+            saa += (double)sum[x] * sum[x];
+            sbb += (double)sum[x + lag] * sum[x + lag];
         }
-        if (r[1] >= best && r[1] >= r[0] && r[1] >= r[2]) {
-            best_lag = lag;
-            break;
-        }
+        r[lag] = saa > 0.0 && sbb > 0.0 ? (float)(sab / sqrt(saa * sbb)) : 0.0f;
     }
-    if (!best_lag) return 0.0;
-    n[0] = c;
-    n[1] = s;
-    return best_lag * bin_w * sc;
+    for (lag = PERIOD_MIN; lag <= max_lag; lag++)
+        if (r[lag] >= PERIOD_CORR && r[lag] >= r[lag - 1] && r[lag] >= r[lag + 1]) {
+            n[0] = c;
+            n[1] = s;
+            return lag * step * sc;
+        }
+    return 0.0;
 }
 
 double home__refine_alias_ratio(home_context *ctx, int slot, const double *h, double *period)
