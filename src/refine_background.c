@@ -31,7 +31,8 @@
 #define MIN_SHARE 48        /* fewer than 1/MIN_SHARE of the pixels: no test */
 
 /* The background of A and B in sixteenths smoothed by the 5-tap binomial (sigma 1 px) in both
- * directions, edges replicated. */
+ * directions, edges replicated. Rows, then columns in place with the interior apart from the
+ * two pixels at each end, so that the compiler vectorises both. */
 static void smooth(const uint16_t *in, int w, int h, int16_t *out)
 {
     int x, y;
@@ -47,14 +48,21 @@ static void smooth(const uint16_t *in, int w, int h, int16_t *out)
     }
     for (y = 0; y < h; y++) {
         int16_t *o = out + (ptrdiff_t)y * w;
-        int m2 = o[0], m1 = o[0], c = o[0];
-        for (x = 0; x < w; x++) {
-            const int p1 = o[x + 1 < w ? x + 1 : w - 1], p2 = o[x + 2 < w ? x + 2 : w - 1];
-            o[x] = (int16_t)((m2 + 4 * m1 + 6 * c + 4 * p1 + p2 + 8) >> 4);
-            m2 = m1;
-            m1 = c;
-            c = p1;
-        }
+        /* the two pixels at each end from the replicated edges; the interior is written two
+         * pixels early (o[x - 2] is read for the last time when it is written) and moved back */
+        const int e0 = o[0], e1 = o[1], e2 = o[2], f0 = o[w - 1], f1 = o[w - 2], f2 = o[w - 3];
+        const int first0 = (e0 + 4 * e0 + 6 * e0 + 4 * e1 + e2 + 8) >> 4;
+        const int first1 = (e0 + 4 * e0 + 6 * e1 + 4 * e2 + o[3] + 8) >> 4;
+        const int last1 = (o[w - 4] + 4 * f2 + 6 * f1 + 4 * f0 + f0 + 8) >> 4;
+        const int last0 = (f2 + 4 * f1 + 6 * f0 + 4 * f0 + f0 + 8) >> 4;
+        for (x = 2; x < w - 2; x++)
+            o[x - 2] =
+                (int16_t)((o[x - 2] + 4 * o[x - 1] + 6 * o[x] + 4 * o[x + 1] + o[x + 2] + 8) >> 4);
+        for (x = w - 3; x >= 2; x--) o[x] = o[x - 2];
+        o[0] = (int16_t)first0;
+        o[1] = (int16_t)first1;
+        o[w - 2] = (int16_t)last1;
+        o[w - 1] = (int16_t)last0;
     }
 }
 
