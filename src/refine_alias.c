@@ -25,7 +25,8 @@ static double find_period(const home__refine_state *st, int slot, double *n)
     const double sc = (double)((1 << st->background_level) * st->background_factor);
     float *sum = (float *)st->scratch, *count = sum + PROFILE_BINS, *r = count + PROFILE_BINS;
     int x, y, lag, bins, max_lag;
-    long sxx = 0, syy = 0, sxy = 0, total = 0;
+    int64_t sxx = 0, syy = 0, sxy = 0;
+    long total = 0;
     double phi, c, s, span, step, mean = 0.0;
     if (!a || w < 8 || h < 8) return 0.0;
     for (y = 1; y < h - 1; y++) {
