@@ -202,6 +202,13 @@ static int model_solve(const home__refine_solver *s, double *a, double *b)
     return 1;
 }
 
+/* Point i of level `level`'s template lies in a region the solver leaves out. */
+static int is_excluded(const home__refine_solver *s, const home__refine_points *tp, int i,
+                       int level)
+{
+    return s->excluded[region_of(tp->x[i], tp->y[i], s->st->w[level], s->st->h[level])] != 0;
+}
+
 /* One IRLS Gauss-Newton step at a level. Returns 0 when too few points stay usable or the
  * system is singular; *step_px gets the corner motion of the update. */
 static int iterate(home__refine_solver *s, int level, double *step_px)
@@ -223,9 +230,7 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     if (s->excluded && s->mask_level != level) {
         /* the points of excluded regions as outside the frame (img_b2 is free while solving) */
         for (i = 0; i < n4; i++)
-            s->img_b2[i] = i < tp->n && s->excluded[region_of(tp->x[i], tp->y[i], st->w[level],
-                                                              st->h[level])]
-                               ? -1.0f : 0.0f;
+            s->img_b2[i] = i < tp->n && is_excluded(s, tp, i, level) ? -1.0f : 0.0f;
         s->mask_level = level;
     }
     valid = home__refine_fit_photometric(s, tp, s->img_b, s->excluded ? s->img_b2 : NULL,
@@ -625,8 +630,7 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
         if (excluded) {
             int i;
             for (i = 0; i < tp->n; i++)
-                if (excluded[region_of(tp->x[i], tp->y[i], st->w[fl], st->h[fl])])
-                    s.img_b[i] = s.img_b2[i] = -1.0f;
+                if (is_excluded(&s, tp, i, fl)) s.img_b[i] = s.img_b2[i] = -1.0f;
         }
         s.alpha = 1.0;
         s.beta = 0.0;
