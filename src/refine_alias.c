@@ -29,14 +29,20 @@ static double find_period(const home__refine_state *st, int slot, double *n)
     long total = 0;
     double phi, c, s, span, step, mean = 0.0;
     if (!a || w < 8 || h < 8) return 0.0;
+    /* a row's sums fit 32 bits (at most HOME__BACKGROUND_PIXELS / 8 terms of at most 255^2), so
+     * the compiler keeps them in vector lanes */
     for (y = 1; y < h - 1; y++) {
         const uint8_t *p = a + (ptrdiff_t)y * w;
+        int32_t rxx = 0, ryy = 0, rxy = 0;
         for (x = 1; x < w - 1; x++) {
             const int gx = p[x + 1] - p[x - 1], gy = p[x + w] - p[x - w];
-            sxx += gx * gx;
-            syy += gy * gy;
-            sxy += gx * gy;
+            rxx += gx * gx;
+            ryy += gy * gy;
+            rxy += gx * gy;
         }
+        sxx += rxx;
+        syy += ryy;
+        sxy += rxy;
     }
     if (!(sxx + syy > 0)) return 0.0;
     phi = 0.5 * atan2(2.0 * (double)sxy, (double)(sxx - syy));

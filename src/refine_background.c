@@ -26,13 +26,15 @@
 #define BORDER 3            /* pixels at the border: no gradient of the smoothed image */
 #define CLIP_MARGIN 8       /* sixteenths: a pixel this close to 0 or 255 is clipped */
 #define REJECT_SIGMAS 4.0   /* residuals farther from the median: occluded or changed */
-#define HIST_BINS 512       /* |r - median| in halves of a sixteenth (the rest in one); r's
-                               grey levels for its median */
+#define MAD_RADIUS 256      /* |r - median| in sixteenths told apart below this (the rest in
+                               one) */
+#define MAD_WINDOW (2 * MAD_RADIUS + 16)   /* at least the 512 grey levels of r's median */
 #define MIN_SHARE 48        /* fewer than 1/MIN_SHARE of the pixels: no test */
 
 /* The background of A and B in sixteenths smoothed by the 5-tap binomial (sigma 1 px) in both
  * directions, edges replicated. Rows, then columns in place with the interior apart from the
- * two pixels at each end, so that the compiler vectorises both. */
+ * two pixels at each end, so that the compiler vectorises both. The sums are taken modulo 2^16:
+ * sixteenths of a grey level are at most 4080, so 16 times that plus the rounding fits. */
 static void smooth(const uint16_t *in, int w, int h, int16_t *out)
 {
     int x, y;
@@ -44,7 +46,8 @@ static void smooth(const uint16_t *in, int w, int h, int16_t *out)
         const uint16_t *r4 = in + (ptrdiff_t)(y + 2 >= h ? h - 1 : y + 2) * w;
         int16_t *o = out + (ptrdiff_t)y * w;
         for (x = 0; x < w; x++)
-            o[x] = (int16_t)((r0[x] + 4 * r1[x] + 6 * r2[x] + 4 * r3[x] + r4[x] + 8) >> 4);
+            o[x] = (int16_t)((uint16_t)(r0[x] + 4 * r1[x] + 6 * r2[x] + 4 * r3[x] + r4[x] + 8) >>
+                             4);
     }
     for (y = 0; y < h; y++) {
         int16_t *o = out + (ptrdiff_t)y * w;
@@ -56,8 +59,9 @@ static void smooth(const uint16_t *in, int w, int h, int16_t *out)
         const int last1 = (o[w - 4] + 4 * f2 + 6 * f1 + 4 * f0 + f0 + 8) >> 4;
         const int last0 = (f2 + 4 * f1 + 6 * f0 + 4 * f0 + f0 + 8) >> 4;
         for (x = 2; x < w - 2; x++)
-            o[x - 2] =
-                (int16_t)((o[x - 2] + 4 * o[x - 1] + 6 * o[x] + 4 * o[x + 1] + o[x + 2] + 8) >> 4);
+            o[x - 2] = (int16_t)((uint16_t)(o[x - 2] + 4 * o[x - 1] + 6 * o[x] + 4 * o[x + 1] +
+                                            o[x + 2] + 8) >>
+                                 4);
         for (x = w - 3; x >= 2; x--) o[x] = o[x - 2];
         o[0] = (int16_t)first0;
         o[1] = (int16_t)first1;
@@ -67,43 +71,47 @@ static void smooth(const uint16_t *in, int w, int h, int16_t *out)
 }
 
 /* Which pixels are background: no texture in A or B within TEXTURE_NEAR, neither clipped, not at
- * the border. tmp: w x h bytes. */
+ * the border. tmp: w x h bytes. Each pass is a loop over a row without branches (the compiler
+ * vectorises them): texture into mask, its dilation along the rows into tmp, along the columns
+ * back into mask. */
 static void find_background(const uint16_t *a, const uint16_t *b, int w, int h, uint8_t *tmp,
                             uint8_t *mask)
 {
     int x, y, k;
     memset(mask, 0, (size_t)w * (size_t)h);
-    for (y = 1; y < h - 1; y++)
+    for (y = 1; y < h - 1; y++) {
+        const uint16_t *ra = a + (ptrdiff_t)y * w, *rb = b + (ptrdiff_t)y * w;
+        uint8_t *o = mask + (ptrdiff_t)y * w;
         for (x = 1; x < w - 1; x++) {
-            const ptrdiff_t i = (ptrdiff_t)y * w + x;
-            const int sa = abs(a[i + 1] - a[i - 1]) + abs(a[i + w] - a[i - w]);
-            const int sb = abs(b[i + 1] - b[i - 1]) + abs(b[i + w] - b[i - w]);
-            mask[i] = sa >= TEXTURE_SCORE || sb >= TEXTURE_SCORE;
+            const int sa = abs(ra[x + 1] - ra[x - 1]) + abs(ra[x + w] - ra[x - w]);
+            const int sb = abs(rb[x + 1] - rb[x - 1]) + abs(rb[x + w] - rb[x - w]);
+            o[x] = (uint8_t)((sa >= TEXTURE_SCORE) | (sb >= TEXTURE_SCORE));
         }
-    /* texture dilated by running counts over the window: rows into tmp, then columns back */
+    }
     for (y = 0; y < h; y++) {
         const uint8_t *in = mask + (ptrdiff_t)y * w;
         uint8_t *out = tmp + (ptrdiff_t)y * w;
-        int count = 0;
-        for (k = 0; k < TEXTURE_NEAR && k < w; k++) count += in[k];
-        for (x = 0; x < w; x++) {
-            if (x + TEXTURE_NEAR < w) count += in[x + TEXTURE_NEAR];
-            if (x - TEXTURE_NEAR - 1 >= 0) count -= in[x - TEXTURE_NEAR - 1];
-            out[x] = count > 0;
+        memcpy(out, in, (size_t)w);
+        for (k = 1; k <= TEXTURE_NEAR && k < w; k++) {
+            for (x = 0; x < w - k; x++) out[x] |= in[x + k];
+            for (x = k; x < w; x++) out[x] |= in[x - k];
         }
     }
-    for (x = 0; x < w; x++) {
-        int count = 0;
-        for (k = 0; k < TEXTURE_NEAR && k < h; k++) count += tmp[(ptrdiff_t)k * w + x];
-        for (y = 0; y < h; y++) {
-            const ptrdiff_t i = (ptrdiff_t)y * w + x;
-            if (y + TEXTURE_NEAR < h) count += tmp[i + (ptrdiff_t)TEXTURE_NEAR * w];
-            if (y - TEXTURE_NEAR - 1 >= 0) count -= tmp[i - (ptrdiff_t)(TEXTURE_NEAR + 1) * w];
-            /* clipped pixels hold no noise and no motion */
-            mask[i] = !count && x >= BORDER && y >= BORDER && x < w - BORDER && y < h - BORDER &&
-                      a[i] > CLIP_MARGIN && b[i] > CLIP_MARGIN && a[i] < 4080 - CLIP_MARGIN &&
-                      b[i] < 4080 - CLIP_MARGIN;
+    for (y = 0; y < h; y++) {
+        uint8_t *out = mask + (ptrdiff_t)y * w;
+        const uint16_t *ra = a + (ptrdiff_t)y * w, *rb = b + (ptrdiff_t)y * w;
+        memset(out, 0, (size_t)w);
+        if (y < BORDER || y >= h - BORDER) continue;
+        for (k = y - TEXTURE_NEAR; k <= y + TEXTURE_NEAR; k++) {
+            const uint8_t *in = tmp + (ptrdiff_t)k * w;
+            if (k < 0 || k >= h) continue;
+            for (x = 0; x < w; x++) out[x] |= in[x];
         }
+        /* clipped pixels hold no noise and no motion */
+        for (x = BORDER; x < w - BORDER; x++)
+            out[x] = (uint8_t)(!out[x] & (ra[x] > CLIP_MARGIN) & (rb[x] > CLIP_MARGIN) &
+                               (ra[x] < 4080 - CLIP_MARGIN) & (rb[x] < 4080 - CLIP_MARGIN));
+        for (x = 0; x < BORDER && x < w; x++) out[x] = out[w - 1 - x] = 0;
     }
 }
 
@@ -177,13 +185,16 @@ static long prepare(const home__refine_state *st, const uint16_t *a, const uint1
 {
     const int w = st->background_w, hh = st->background_h;
     uint8_t *mask = st->flat;
-    int hist[HIST_BINS + 1], fine[16], x, y, i, j, f, half, cum;
+    int hist[MAD_WINDOW], x, y, i, j, f, c, t, half, cum, lo;
     long n = 0;
     if (!st->levels || w < 2 * BORDER + 2 || hh < 2 * BORDER + 2) return 0;
     home__refine_background_matrix(st, h, m);
     if (!invert3(m, m_inv)) return 0;
     find_background(a, b, w, hh, (uint8_t *)(void *)st->sampled, mask);
-    /* the pixels h and its inverse keep inside the frame: the predictions need both */
+    /* the pixels h and its inverse keep inside the frame (the predictions need both), and the
+     * histogram of r = B - A there (sixteenths, within +-4095) by grey levels: for its median,
+     * the grey level, then the sixteenth */
+    memset(hist, 0, sizeof hist);
     for (y = BORDER; y < hh - BORDER; y++)
         for (x = BORDER; x < w - BORDER; x++) {
             const ptrdiff_t p = (ptrdiff_t)y * w + x;
@@ -192,31 +203,30 @@ static long prepare(const home__refine_state *st, const uint16_t *a, const uint1
             mask[p] = apply(m, x, y, &u, &v) && u >= 0.0 && v >= 0.0 && u <= w - 1 &&
                       v <= hh - 1 && apply(m_inv, x, y, &u, &v) && u >= 0.0 && v >= 0.0 &&
                       u <= w - 1 && v <= hh - 1;
-            n += mask[p];
+            if (!mask[p]) continue;
+            n++;
+            hist[((int)b[p] - (int)a[p] + 4096) >> 4]++;
         }
     if (n * MIN_SHARE < (long)w * hh) return 0;
-    /* the median of r = B - A (sixteenths, within +-4095): its grey level, then its sixteenth */
-    memset(hist, 0, sizeof hist);
-    for (i = 0; i < w * hh; i++)
-        if (mask[i]) hist[((int)b[i] - (int)a[i] + 4096) >> 4]++;
     half = (int)(n / 2);
     for (j = 0, cum = 0; j < 511 && cum + hist[j] <= half; j++) cum += hist[j];
-    memset(fine, 0, sizeof fine);
-    for (i = 0; i < w * hh; i++) {
-        const int v = (int)b[i] - (int)a[i] + 4096;
-        if (mask[i] && v >> 4 == j) fine[v & 15]++;
-    }
-    for (f = 0; f < 15 && cum + fine[f] <= half; f++) cum += fine[f];
-    *median = 16 * j + f - 4096;
+    /* then r by sixteenths from MAD_RADIUS below that grey level to MAD_RADIUS above it: the
+     * median's sixteenth, and about the median |r - median| out to MAD_RADIUS for the spread */
+    lo = 16 * j - 4096 - MAD_RADIUS;
     memset(hist, 0, sizeof hist);
     for (i = 0; i < w * hh; i++) {
-        double d;
-        if (!mask[i]) continue;
-        d = fabs((int)b[i] - (int)a[i] - *median) * 2.0;
-        hist[d < HIST_BINS ? (int)d : HIST_BINS]++;
+        const unsigned v = (unsigned)((int)b[i] - (int)a[i] - lo);
+        if (mask[i] && v < MAD_WINDOW) hist[v]++;
     }
-    for (i = 0, cum = 0; i < HIST_BINS && cum + hist[i] <= half; i++) cum += hist[i];
-    *mad = 1.4826 * (i + 0.5) / 2.0;
+    for (f = 0; f < 15 && cum + hist[MAD_RADIUS + f] <= half; f++) cum += hist[MAD_RADIUS + f];
+    *median = 16 * j + f - 4096;
+    c = MAD_RADIUS + f;
+    for (t = 0, cum = 0; t < MAD_RADIUS; t++) {
+        const int count = hist[c + t] + (t ? hist[c - t] : 0);
+        if (cum + count > half) break;
+        cum += count;
+    }
+    *mad = 1.4826 * (t + 0.25);
     if (*mad < 1.0) *mad = 1.0;
     return n;
 }

@@ -383,11 +383,17 @@ static void store_background(home__refine_state *st, int slot)
     const int w = st->background_w, h = st->background_h, stride = st->w[l];
     const int src = l > st->base_level ? l - 1 : l, g = f << (l - src), src_stride = st->w[src];
     int x, y;
-    for (y = 0; y < h; y++)
+    for (y = 0; y < h; y++) {
+        uint8_t *o = st->background[slot] + (ptrdiff_t)y * w;
+        if (f == 1) {   /* up to HOME__BACKGROUND_PIXELS at the level: the level itself */
+            memcpy(o, st->pyr[l] + (ptrdiff_t)y * stride, (size_t)w);
+            continue;
+        }
         for (x = 0; x < w; x++) {
             const long sum = box_sum(st->pyr[l] + (ptrdiff_t)(y * f) * stride + x * f, stride, f);
-            st->background[slot][(ptrdiff_t)y * w + x] = (uint8_t)((sum + f * f / 2) / (f * f));
+            o[x] = (uint8_t)((sum + f * f / 2) / (f * f));
         }
+    }
     if (g == 2) {   /* the usual case: 16 x the mean of 2 x 2 is 4 x their sum, exactly */
         for (y = 0; y < h; y++) {
             const uint8_t *r0 = st->pyr[src] + (ptrdiff_t)(2 * y) * src_stride;
