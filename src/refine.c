@@ -54,11 +54,6 @@
                                 own translation is below this share of the motion's: tuning
                                 set, a hand at the lens 0.13-0.27, blocks an encoder left 0.09-
                                 0.18, the background behind a textured object 0.55-1.75 */
-#define ALIAS_RATIO 1.75     /* an ok motion is refused when the refinement reaches an optimum one
-                                period of a repeated pattern away whose mean robust cost is at
-                                most this many times its own: tuning set, group d, the alias
-                                optima 0.32-1.19 (the 5 silent answers 0.32-1.02), the others
-                                2.6 and more */
 #define VOUCH_ZNCC 0.9       /* a refined estimate vouches for itself at this correlation */
 #define VOUCH_SIGMA_SHARE 0.4 /* ... and a predicted error within this share of max_sigma_px:
                                  without HOME's confirmation, the tuning set's wrong refined
@@ -253,7 +248,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
      * of the two is right, nothing in the pair tells */
     if (trial.ok) {
         double period;
-        if (home__refine_alias_ratio(ctx, slot, trial.H, &period) <= ALIAS_RATIO) {
+        if (home__refine_aliased(ctx, slot, trial.H, &period)) {
             trial.ok = 0;
             trial.failure = HOME_FAIL_UNCERTAIN;
             trial.refine_status = HOME_REFINE_PERIODIC;

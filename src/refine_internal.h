@@ -89,6 +89,11 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, home_resu
  * motion of the rest of the frame. */
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,
                                 const unsigned char *excluded, home_result *result);
+/* The same from h0 as a probe for another optimum: given up (not refined) as soon as the
+ * estimate lies within radius (full-size px at the corners) of back or radius or more from h0,
+ * or a level does not converge. */
+void home__refine_probe(home_context *ctx, int slot, const double *h0, const double *back,
+                        double radius, home_result *result);
 
 /* refine_static.c */
 /* h (full-size pixels) as a map of background pixels, into m. */
@@ -124,10 +129,11 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
                                   const double *h, double *observed, double *expected,
                                   double *evidence, double *own_motion);
 
-/* refine_alias.c: frame A's period (full-size px; 0: none found) and, when there is one, the
- * mean robust cost of the optimum the refinement reaches from h shifted by one period either
- * way (the better, if away from h) over h's own, on the identity test's region points
- * (INFINITY without a period or an alias). Uses the match-time scratch. */
-double home__refine_alias_ratio(home_context *ctx, int slot, const double *h, double *period);
+/* refine_alias.c: 1 when the refinement, started from h shifted by one period of frame A's
+ * repeated pattern either way (periods along a few directions, up to three of them tried),
+ * reaches an optimum away from h that explains the identity test's region points about as
+ * well as h (mean robust cost within a bound), with that period (full-size px) in *period;
+ * else 0. Uses the match-time scratch. */
+int home__refine_aliased(home_context *ctx, int slot, const double *h, double *period);
 
 #endif

@@ -542,8 +542,26 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
  * without the points of the excluded regions (NULL: none). Writes the refined H and fills the
  * refine fields of result. */
+/* A probe's leash: the refinement gives up as soon as its estimate lies within radius of back
+ * (it came back: no optimum of its own) or radius or more from h0 (it went elsewhere), or a
+ * level ends without converging. */
+typedef struct probe_leash {
+    const double *back;
+    double radius;
+} probe_leash;
+
+/* A probe's estimate came back or went elsewhere. */
+static int off_leash(const home__refine_solver *s, const double *h0, const probe_leash *leash)
+{
+    double h[9];
+    to_pixels(s, s->hn, h);
+    return home__refine_max_corner_distance(s->cx, s->cy, h, leash->back) < leash->radius ||
+           !(home__refine_max_corner_distance(s->cx, s->cy, h, h0) < leash->radius);
+}
+
 static double refine_run(home_context *ctx, int slot, const double *h0,
-                         const unsigned char *excluded, home_result *result)
+                         const unsigned char *excluded, const probe_leash *leash,
+                         home_result *result)
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
@@ -593,7 +611,9 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
             /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
             if (step > 0.5 * last_step) s.hessian_level = -1;
             last_step = step;
+            if (leash && off_leash(&s, h0, leash)) break;
         }
+        if (leash && !converged) break;
     }
     result->refine_iterations = iterations;
     if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return 0.0; }
@@ -663,11 +683,20 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
 
 double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)
 {
-    return refine_run(ctx, slot, h0, NULL, result);
+    return refine_run(ctx, slot, h0, NULL, NULL, result);
 }
 
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,
                                 const unsigned char *excluded, home_result *result)
 {
-    return refine_run(ctx, slot, h0, excluded, result);
+    return refine_run(ctx, slot, h0, excluded, NULL, result);
+}
+
+void home__refine_probe(home_context *ctx, int slot, const double *h0, const double *back,
+                        double radius, home_result *result)
+{
+    probe_leash leash;
+    leash.back = back;
+    leash.radius = radius;
+    refine_run(ctx, slot, h0, NULL, &leash, result);
 }

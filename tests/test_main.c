@@ -16,7 +16,8 @@
     X(kernels_smooth) X(kernels_box_down) X(kernels_extremum_candidates) X(refine_kernels_backends) \
     X(warp_backends_identical) X(warp_plane_end) X(backends_identical_output) X(fast_hough_matches_exact) \
     X(static_scene_is_identity) X(shift_is_translation) X(model_cap) X(sigma_calibrated) X(few_edges_never_wrong) \
-    X(textured_mover_never_steers) X(static_fog_is_identity) X(raw_fog_never_moves) X(fence_never_aliased)
+    X(textured_mover_never_steers) X(static_fog_is_identity) X(raw_fog_never_moves) X(fence_never_aliased) \
+    X(pegboard_never_aliased)
 
 #define DECLARE(name) void test_##name(void);
 TEST_LIST(DECLARE)

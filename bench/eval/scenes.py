@@ -15,6 +15,8 @@ scenes the tuning set never showed in form, not only in seed:
                 soft blob                                corner, vignetted
   repeated      floor tiles / picket fence               brick bond / window grid /
                                                          chain-link lattice
+  lattice       rectangular tiles / pegboard (two        (none: tuning only)
+                unequal periods)
   textureless   a few large Gaussian blobs               a low-frequency cosine field and
                                                          one soft shadow
 
@@ -29,7 +31,7 @@ import numpy as np
 
 from common import rng_for
 
-KINDS = ["few_edges", "fog_horizon", "dim_gradient", "repeated", "textureless"]
+KINDS = ["few_edges", "fog_horizon", "dim_gradient", "repeated", "lattice", "textureless"]
 VARIANTS = {"A": "tuning generator", "B": "test generator"}
 
 
@@ -232,6 +234,32 @@ def _repeated_b(rng, w, h):
     return _perspective(img, rng, 0.04)
 
 
+def _lattice_a(rng, w, h):
+    """Tuning only (added when the test set's brick walls and window grids showed that a
+    pattern repeating along two directions with two periods defeats a one-direction alias
+    test): rectangular tiles or a pegboard, periods unequal in x and y."""
+    kind = int(rng.integers(2))
+    px, py = rng.uniform(35, 90), rng.uniform(22, 60)
+    if kind == 0:                              # rectangular wall tiles, thin grout
+        grout = rng.uniform(2, 4)
+        tile, gv = rng.uniform(140, 210), rng.uniform(60, 110)
+        shade = rng.normal(0, 6, (64, 64))
+
+        def f(x, y):
+            on = ((x % px) > grout) & ((y % py) > grout)
+            s = shade[np.floor(y / py).astype(int) % 64, np.floor(x / px).astype(int) % 64]
+            return np.where(on, tile + s, gv)
+    else:                                      # pegboard: dark holes in a light board
+        r = rng.uniform(0.12, 0.22) * min(px, py)
+        board, hole = rng.uniform(150, 210), rng.uniform(20, 60)
+
+        def f(x, y):
+            dx, dy = (x % px) - px / 2, (y % py) - py / 2
+            return np.where(dx * dx + dy * dy < r * r, hole, board)
+    img = _supersampled(f, w, h) + _illumination(rng, w, h, 20)
+    return _perspective(img, rng, 0.04)
+
+
 # -- textureless -----------------------------------------------------------
 def _textureless_a(rng, w, h):
     x, y = _grid(w, h)
@@ -264,6 +292,7 @@ _RENDERERS = {
     ("fog_horizon", "A"): _fog_horizon_a, ("fog_horizon", "B"): _fog_horizon_b,
     ("dim_gradient", "A"): _dim_gradient_a, ("dim_gradient", "B"): _dim_gradient_b,
     ("repeated", "A"): _repeated_a, ("repeated", "B"): _repeated_b,
+    ("lattice", "A"): _lattice_a,
     ("textureless", "A"): _textureless_a, ("textureless", "B"): _textureless_b,
 }
 

@@ -267,6 +267,7 @@ def still_groups(which):
             + _scenes("few_edges", "A", sd[6:8], "few edges in low light", "lowlight")
             + _scenes("repeated", "A", sd[6:8], "repeated pattern in low light", "lowlight"),
             "repeated": _scenes("repeated", "A", sd[:8], "tiles or a fence")
+            + _scenes("lattice", "A", sd[:6], "rectangular tiles or a pegboard")
             + [Item("brick wall", photo=_tp("brick")),
                Item("printed sudoku grid", photo=_tp("sudoku")),
                Item("calibration chessboard", photo=_tp("left01"))],
@@ -296,6 +297,8 @@ def still_groups(which):
         + _scenes("few_edges", "B", sd[6:8], "few edges in low light", "lowlight")
         + _scenes("repeated", "B", sd[6:8], "repeated pattern in low light", "lowlight"),
         "repeated": _scenes("repeated", "B", sd[:8], "bricks, windows or a chain-link fence")
+        + _scenes("repeated", "B", sd[8:12], "bricks, windows or a chain-link fence")
+        + _scenes("lattice", "A", sd[:2], "rectangular tiles or a pegboard (test seeds)")
         + [Item(T[k].why, photo=T[k]) for k in ("parrot", "hawa_mahal", "aqueduct",
                                                  "columns")],
         "line_rich": [Item(T[k].why, photo=T[k]) for k in
