@@ -77,6 +77,11 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
     const uint16x8_t step_x = vdupq_n_u16((uint16_t)(8u * (uint32_t)dx)),
                      step_y = vdupq_n_u16((uint16_t)(8u * (uint32_t)dy));
     const uint32_t dx8 = 8u * (uint32_t)dx, dy7 = 7u * (uint32_t)dy, dy8 = 8u * (uint32_t)dy;
+    /* a / |dy8| for a < 2^16 as a multiply by ceil(2^32 / |dy8|), exact (the error a e / 2^32,
+     * e < |dy8| <= 2^16, stays below 1 / |dy8|): armv7 has no divide instruction, and the runs
+     * below need one each. 0: |dy8| > a, the quotient is 0. */
+    const uint32_t ady8 = dy > 0 ? dy8 : 0u - dy8;
+    const uint32_t dy8_inv = ady8 >= 8 && ady8 <= 0xffffu ? 0xffffffffu / ady8 + 1 : 0;
     /* the window path: a group's pairs within 16 bytes (dx in [0, 2): pixel 7's pair at offset
      * <= 13 + 1) and the window inside the row (x >> 16 <= w - 16: x < xlim); x grows, so a
      * prefix of the groups */
@@ -121,9 +126,9 @@ static void warp_row_neon(const uint8_t *src, ptrdiff_t stride, int w, int32_t x
              * was, so its last decides: the groups up to stop stay on it (yrel + (g - 1) dy8 in
              * [0, 2^16) for g of them) */
             const uint8_t *const row1 = row + stride;
-            const uint32_t g = dy > 0   ? (0xffffu - yrel) / dy8 + 1
-                               : dy < 0 ? yrel / (0u - dy8) + 1
-                                        : 0xffffffu;
+            const uint32_t g =
+                dy ? (uint32_t)((uint64_t)(dy > 0 ? 0xffffu - yrel : yrel) * dy8_inv >> 32) + 1
+                   : 0xffffffu;
             uint8_t *const stop = (uint32_t)(fast_end - d) / 8 > g ? d + 8 * (ptrdiff_t)g
                                                                    : fast_end;
             yrel += (uint32_t)(stop - d) / 8 * dy8;
