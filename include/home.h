@@ -130,11 +130,12 @@ typedef struct home_config {
                                  transform of a 2x2- or 4x4-box downscaled copy, half the theta
                                  bins and keypoints, the same refinement) and the configured
                                  pass only when the fast one's answer is not ok; 0 = one pass.
-                                 Runs with the FAST transform and the refinement, when this
-                                 exceeds hough_downscale (else one pass). Default 0: 4 at
-                                 640x360 took 0.13-0.25x the time at the same errors on the
-                                 evaluation's tuning set, but let wrong answers through on its
-                                 test set (repeated patterns; docs/speed.md) */
+                                 The fast answer stands only when its sigma_px is at most
+                                 0.2. Runs with the FAST transform and the refinement, when
+                                 this exceeds hough_downscale (else one pass). Default 4 from
+                                 640 x 4 * HOME_MIN_SIDE up (the same errors and silent errors
+                                 in the evaluation, in a fraction of the time: docs/speed.md),
+                                 else 0; the video preset 0 */
     home_clock_fn clock;      /* optional: per-stage timings in home_result.ms */
     void *clock_user;
 } home_config;
@@ -322,7 +323,8 @@ typedef struct home_result {
  * identity (HOME_REFINE_STATIC). One the identity clearly explains better in a tenth of the
  * clearly decided regions is two motions, not ok (HOME_REFINE_STILL_REGIONS,
  * HOME_FAIL_INCONSISTENT); so is HOME's kept estimate when the refinement converged
- * ill-conditioned more than 2 predicted errors (both estimates') away from it. The plain background judges pixel by pixel: a motion becomes the
+ * ill-conditioned more than 2 predicted errors (both estimates') away from it. The plain
+ * background judges pixel by pixel: a motion becomes the
  * identity when the plain regions (no textured block) outnumber the textured regions that prefer
  * it and their flat pixels prefer the identity at z >= 6; and it is not ok
  * (HOME_REFINE_STILL_BACKGROUND, HOME_FAIL_INCONSISTENT) when the frame's background away from
@@ -331,10 +333,11 @@ typedef struct home_result {
  * refine_status says whether that background stands still (STILL_BACKGROUND: its own
  * translation below 0.4 of the motion's) or moves otherwise (BACKGROUND_MOVES).
  *
- * Repeated patterns: where frame A repeats along its dominant gradient direction and the
- * refinement, started one period away either way, reaches an optimum that fits at most 1.75
- * times worse than the answer, the pair cannot tell the two apart: not ok
- * (HOME_REFINE_PERIODIC, HOME_FAIL_UNCERTAIN, sigma_px at least the period). */
+ * Repeated patterns: where frame A repeats along its dominant gradient direction (or along its
+ * rows, columns or diagonals: tiles, pegboards) and the refinement, started one period away
+ * either way, reaches an optimum there that fits about as well as the answer (at most 1.75
+ * times worse along the dominant direction, 1.07 along the others), the pair cannot tell the
+ * two apart: not ok (HOME_REFINE_PERIODIC, HOME_FAIL_UNCERTAIN, sigma_px at least the period). */
 int home_match(home_context *ctx, const home_features *a, const home_features *b,
                home_result *result);
 

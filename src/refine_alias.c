@@ -51,8 +51,8 @@ typedef char home__alias_scratch_fits[UNIT_BINS_MAX >= 2 * PROFILE_BINS ? 1 : -1
 static int profile_period(float *sum, const float *count, int bins, double spacing, double *v,
                           double *corr)
 {
-    const int min_lag = PERIOD_MIN > (int)ceil(PERIOD_MIN / spacing) ? PERIOD_MIN
-                                                                     : (int)ceil(PERIOD_MIN / spacing);
+    const int px_lag = (int)ceil(PERIOD_MIN / spacing),
+              min_lag = PERIOD_MIN > px_lag ? PERIOD_MIN : px_lag;
     double *squares = (double *)(void *)sum; /* squares[i]: v[0]^2 + ... + v[i]^2 */
     double r[3] = {0.0, 0.0, 0.0}, mean = 0.0, total_sq = 0.0;
     int x, lag, max_lag;
@@ -172,7 +172,10 @@ static int fixed_profile(const uint8_t *a, int w, int h, int kind, int32_t *unit
     memset(count, 0, PROFILE_BINS * sizeof *count);
     for (i = 0; i < units; i++) {
         /* pixels on unit line i: a column, a row, or a diagonal's run */
-        const int len = kind == 0 ? h : kind == 1 ? w : i + 1 < w + h - 1 - i ? i + 1 : w + h - 1 - i;
+        const int len = kind == 0   ? h
+                        : kind == 1 ? w
+                        : i + 1 < w + h - 1 - i ? i + 1
+                                                : w + h - 1 - i;
         const int cap = w < h ? w : h;
         sum[i / k] += (float)unit[i];
         count[i / k] += (float)(kind < 2 ? len : len < cap ? len : cap);

@@ -152,8 +152,11 @@ void test_fast_pass(void)
     synth_rng rng;
     size_t i;
     home_default_config(&cfg, IMG_W, IMG_H);
-    CHECK_EQ_INT(cfg.fast_pass_downscale, 0);
-    cfg.fast_pass_downscale = 4;
+    CHECK_EQ_INT(cfg.fast_pass_downscale, 4);
+    home_default_config(&one, IMG_W / 2, IMG_H / 2);
+    CHECK_EQ_INT(one.fast_pass_downscale, 0);   /* a Hough image under 160 px: one pass */
+    home_video_config(&one, IMG_W, IMG_H);
+    CHECK_EQ_INT(one.fast_pass_downscale, 0);
     render_pair(SYNTH_STRUCTURED, 61, 20, h);
     ctx = test_context(IMG_W, IMG_H, &cfg);
     if (!ctx) { CHECK(0); return; }
@@ -195,11 +198,16 @@ void test_fast_pass(void)
 
 void test_video_reuse_matches_pair(void)
 {
-    /* registering cached features gives exactly what the two-image call gives */
-    home_context *ctx = test_context(IMG_W, IMG_H, NULL);
+    /* registering cached features gives exactly what the two-image call gives in one pass (a
+     * fast pass extracts features of its own) */
+    home_config cfg;
+    home_context *ctx;
     home_result pair, video;
     double h[9];
     synth_rng rng;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.fast_pass_downscale = 0;
+    ctx = test_context(IMG_W, IMG_H, &cfg);
     if (!ctx) { CHECK(0); return; }
     synth_seed(&rng, 31);
     synth_corner_homography(&rng, IMG_W, IMG_H, 15, h);
