@@ -6,7 +6,15 @@
 #include <arm_neon.h>
 
 /* 64 lanes held as 8 x 8 uint16 in registers (vaddw_u8 widens while adding); widened into
- * int32 every 128 rows. */
+ * int32 every 128 rows. Eight named accumulators: gcc keeps an array of vectors indexed in a
+ * loop on the stack, a load and a store around every add. */
+static void add_lanes(int32_t *dst, uint16x8_t a)
+{
+    vst1q_s32(dst, vaddq_s32(vld1q_s32(dst), vreinterpretq_s32_u32(vmovl_u16(vget_low_u16(a)))));
+    vst1q_s32(dst + 4,
+              vaddq_s32(vld1q_s32(dst + 4), vreinterpretq_s32_u32(vmovl_u16(vget_high_u16(a)))));
+}
+
 static void radon_blocks_neon(const uint8_t *base, ptrdiff_t stride, const int16_t *shift, int j0,
                               int n_blocks, const int16_t *row_lo, const int16_t *row_hi,
                               int32_t *out)
@@ -19,25 +27,30 @@ static void radon_blocks_neon(const uint8_t *base, ptrdiff_t stride, const int16
         while (p <= row_hi[b]) {
             int end = p + HOME__RADON_ROWS_16BIT - 1 < row_hi[b] ? p + HOME__RADON_ROWS_16BIT - 1
                                                                  : row_hi[b];
-            uint16x8_t a[8];
-            for (k = 0; k < 8; k++) a[k] = vdupq_n_u16(0);
+            uint16x8_t a0 = vdupq_n_u16(0), a1 = a0, a2 = a0, a3 = a0, a4 = a0, a5 = a0, a6 = a0,
+                       a7 = a0;
             for (; p <= end; p++) {
                 const uint8_t *src = base + (ptrdiff_t)p * stride + j0 + b * HOME__RADON_BLOCK +
                                      shift[p];
-                for (k = 0; k < 4; k++) {
-                    uint8x16_t v = vld1q_u8(src + 16 * k);
-                    a[2 * k] = vaddw_u8(a[2 * k], vget_low_u8(v));
-                    a[2 * k + 1] = vaddw_u8(a[2 * k + 1], vget_high_u8(v));
-                }
+                const uint8x16_t v0 = vld1q_u8(src), v1 = vld1q_u8(src + 16),
+                                 v2 = vld1q_u8(src + 32), v3 = vld1q_u8(src + 48);
+                a0 = vaddw_u8(a0, vget_low_u8(v0));
+                a1 = vaddw_u8(a1, vget_high_u8(v0));
+                a2 = vaddw_u8(a2, vget_low_u8(v1));
+                a3 = vaddw_u8(a3, vget_high_u8(v1));
+                a4 = vaddw_u8(a4, vget_low_u8(v2));
+                a5 = vaddw_u8(a5, vget_high_u8(v2));
+                a6 = vaddw_u8(a6, vget_low_u8(v3));
+                a7 = vaddw_u8(a7, vget_high_u8(v3));
             }
-            for (k = 0; k < 8; k++) {
-                int32_t *dst = acc32 + 8 * k;
-                vst1q_s32(dst, vaddq_s32(vld1q_s32(dst),
-                                         vreinterpretq_s32_u32(vmovl_u16(vget_low_u16(a[k])))));
-                vst1q_s32(dst + 4,
-                          vaddq_s32(vld1q_s32(dst + 4),
-                                    vreinterpretq_s32_u32(vmovl_u16(vget_high_u16(a[k])))));
-            }
+            add_lanes(acc32, a0);
+            add_lanes(acc32 + 8, a1);
+            add_lanes(acc32 + 16, a2);
+            add_lanes(acc32 + 24, a3);
+            add_lanes(acc32 + 32, a4);
+            add_lanes(acc32 + 40, a5);
+            add_lanes(acc32 + 48, a6);
+            add_lanes(acc32 + 56, a7);
         }
     }
 }
