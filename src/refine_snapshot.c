@@ -374,6 +374,20 @@ static long box_sum(const uint8_t *p, int stride, int side)
     return sum;
 }
 
+/* k with 2^k = v, or -1 when v is no power of two */
+static int exact_log2(int v)
+{
+    int k = 0;
+    while (k < 30 && (1 << k) < v) k++;
+    return (1 << k) == v ? k : -1;
+}
+
+/* (sum + d / 2) / d for sum >= 0: a shift when d = 2^k (k >= 0) */
+static long rounded_quotient(long sum, long d, int k)
+{
+    return k >= 0 ? (sum + d / 2) >> k : (sum + d / 2) / d;
+}
+
 /* The slot's background images from the pyramid: box means of f x f at the background level,
  * rounded, and the same boxes from the finer level in sixteenths (the score test's evidence is
  * below a grey level at quarter size). */
@@ -382,35 +396,40 @@ static void store_background(home__refine_state *st, int slot)
     const int f = st->background_factor, l = st->background_level;
     const int w = st->background_w, h = st->background_h, stride = st->w[l];
     const int src = l > st->base_level ? l - 1 : l, g = f << (l - src), src_stride = st->w[src];
+    const int kf = exact_log2(f * f), kg = exact_log2(g * g);
     int x, y;
     for (y = 0; y < h; y++) {
+        const uint8_t *r0 = st->pyr[l] + (ptrdiff_t)(y * f) * stride, *r1 = r0 + stride;
         uint8_t *o = st->background[slot] + (ptrdiff_t)y * w;
         if (f == 1) {   /* up to HOME__BACKGROUND_PIXELS at the level: the level itself */
-            memcpy(o, st->pyr[l] + (ptrdiff_t)y * stride, (size_t)w);
-            continue;
-        }
-        for (x = 0; x < w; x++) {
-            const long sum = box_sum(st->pyr[l] + (ptrdiff_t)(y * f) * stride + x * f, stride, f);
-            o[x] = (uint8_t)((sum + f * f / 2) / (f * f));
+            memcpy(o, r0, (size_t)w);
+        } else if (f == 2) {
+            for (x = 0; x < w; x++)
+                o[x] = (uint8_t)((r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1] + 2) >> 2);
+        } else {
+            for (x = 0; x < w; x++)
+                o[x] = (uint8_t)rounded_quotient(box_sum(r0 + x * f, stride, f), (long)f * f, kf);
         }
     }
-    if (g == 2) {   /* the usual case: 16 x the mean of 2 x 2 is 4 x their sum, exactly */
-        for (y = 0; y < h; y++) {
-            const uint8_t *r0 = st->pyr[src] + (ptrdiff_t)(2 * y) * src_stride;
-            const uint8_t *r1 = r0 + src_stride;
-            uint16_t *o = st->background16[slot] + (ptrdiff_t)y * w;
+    for (y = 0; y < h; y++) {
+        const uint8_t *r0 = st->pyr[src] + (ptrdiff_t)(y * g) * src_stride, *r1 = r0 + src_stride;
+        uint16_t *o = st->background16[slot] + (ptrdiff_t)y * w;
+        if (g == 2) {   /* the usual case: 16 x the mean of 2 x 2 is 4 x their sum, exactly */
             for (x = 0; x < w; x++)
                 o[x] = (uint16_t)(4 * (r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1]));
+        } else if (g == 4) {   /* ... and of 4 x 4 their sum */
+            const uint8_t *r2 = r1 + src_stride, *r3 = r2 + src_stride;
+            for (x = 0; x < w; x++) {
+                const uint8_t *a = r0 + 4 * x, *b = r1 + 4 * x, *c = r2 + 4 * x, *d = r3 + 4 * x;
+                o[x] = (uint16_t)(a[0] + a[1] + a[2] + a[3] + b[0] + b[1] + b[2] + b[3] + c[0] +
+                                  c[1] + c[2] + c[3] + d[0] + d[1] + d[2] + d[3]);
+            }
+        } else {
+            for (x = 0; x < w; x++)
+                o[x] = (uint16_t)rounded_quotient(16 * box_sum(r0 + x * g, src_stride, g),
+                                                  (long)g * g, kg);
         }
-        return;
     }
-    for (y = 0; y < h; y++)
-        for (x = 0; x < w; x++) {
-            const long sum =
-                box_sum(st->pyr[src] + (ptrdiff_t)(y * g) * src_stride + x * g, src_stride, g);
-            st->background16[slot][(ptrdiff_t)y * w + x] =
-                (uint16_t)((16 * sum + g * g / 2) / (g * g));
-        }
 }
 
 /* The selection's block cells, in the scratch after a row of int16 */
