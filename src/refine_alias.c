@@ -90,8 +90,8 @@ static int profile_period(float *sum, const float *count, int bins, double spaci
 }
 
 /* The profile of the background a (w x h) along the dominant gradient direction of its
- * structure tensor: into c (the candidate's direction and period, background px per bin in
- * *spacing). 0 for a flat image. */
+ * structure tensor, into sum and count (unit: scratch for 2 PROFILE_BINS integers): its bins
+ * (0 for a flat image), the direction in n and the background px per bin in *spacing. */
 static int dominant_profile(const uint8_t *a, int w, int h, int32_t *unit, float *sum,
                             float *count, double *n, double *spacing)
 {

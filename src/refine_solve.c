@@ -539,9 +539,6 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
     }
 }
 
-/* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
- * without the points of the excluded regions (NULL: none). Writes the refined H and fills the
- * refine fields of result. */
 /* A probe's leash: the refinement gives up as soon as its estimate lies within radius of back
  * (it came back: no optimum of its own) or radius or more from h0 (it went elsewhere), or a
  * level ends without converging. */
@@ -559,6 +556,9 @@ static int off_leash(const home__refine_solver *s, const double *h0, const probe
            !(home__refine_max_corner_distance(s->cx, s->cy, h, h0) < leash->radius);
 }
 
+/* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
+ * without the points of the excluded regions (NULL: none), on a probe's leash (NULL: none).
+ * Writes the refined H and fills the refine fields of result. */
 static double refine_run(home_context *ctx, int slot, const double *h0,
                          const unsigned char *excluded, const probe_leash *leash,
                          home_result *result)
