@@ -177,13 +177,18 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
     {
         /* each intercept's entry row (rows before it lie left of the image) and the row after
          * its exit (from there on right of it); lines through every row: 0 and rows */
-        const int span = s_max - s_min + 1;
+        const int span = s_max - s_min + 1, in_span = span + 1 < n ? span + 1 : n;
+        const int before_exit = cols < n ? cols : n;
+        const int16_t from_first = (int16_t)g->first_row[0], through_last =
+                                                              (int16_t)g->first_row[span];
         int i;
-        for (i = 0; i < n; i++) {
-            const int j = j0 + i, v_entry = -j - s_min, v_after = cols - j - s_min;
-            g->entry[i] = (int16_t)g->first_row[v_entry < 0 ? 0 : v_entry > span ? span : v_entry];
-            g->after[i] = (int16_t)g->first_row[v_after > span ? span : v_after];
-        }
+        /* with j0 = -s_max - 1, intercept i enters at shift value span - i (clamped at 0: from
+         * the first row) and leaves at cols + span - i (clamped at span: through the last
+         * row), never below 0 (n = cols + span): runs of one value and reversed copies */
+        for (i = 0; i < in_span; i++) g->entry[i] = (int16_t)g->first_row[span - i];
+        for (; i < n; i++) g->entry[i] = from_first;
+        for (i = 0; i < before_exit; i++) g->after[i] = through_last;
+        for (; i < n; i++) g->after[i] = (int16_t)g->first_row[cols + span - i];
     }
     g->d_scale = (float)(inv_abs_a / a);
     g->end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
