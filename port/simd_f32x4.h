@@ -102,11 +102,18 @@ static inline home__fv home__fv_div(home__fv a, home__fv b)
 #endif
 }
 
+/* lane k's mask as bit k, in registers (a store and four loads cost the extremum scan more than
+ * its compares on armv7) */
 static inline int home__mv_bits(home__mv m)
 {
-    uint32_t b[4];
-    vst1q_u32(b, m);
-    return (b[0] & 1) | (b[1] & 2) | (b[2] & 4) | (b[3] & 8);
+    static const uint32_t bit[4] = {1, 2, 4, 8};
+    const uint32x4_t b = vandq_u32(m, vld1q_u32(bit));
+#if defined(__aarch64__)
+    return (int)vaddvq_u32(b);
+#else
+    const uint32x2_t s = vpadd_u32(vget_low_u32(b), vget_high_u32(b));
+    return (int)vget_lane_u32(vpadd_u32(s, s), 0);
+#endif
 }
 
 static inline home__iv home__iv_iota(void)
