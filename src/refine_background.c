@@ -17,7 +17,6 @@
  * (occlusion) and clipped pixels are left out. */
 #include "refine_internal.h"
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #define TEXTURE_SCORE 128   /* |gx| + |gy| (2x central differences, sixteenths): texture, */
