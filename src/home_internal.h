@@ -66,6 +66,7 @@ typedef struct home__refine_state {
     uint8_t *pyr[HOME_REFINE_MAX_LEVELS];
     uint32_t pyr_id, slot_id[2];
     int next_slot;
+    int pending_slot;                 /* its template points not yet selected (deferred), or -1 */
     home__refine_points tpl[2][HOME_REFINE_MAX_LEVELS];
     home__refine_points regions[2];   /* the strongest points of every region of a grid at
                                          region_level, for the identity test (x, y, t only) */
@@ -92,14 +93,15 @@ typedef struct home__refine_state {
 /* FAST: what one theta row of the transform needs that depends only on theta and the Hough
  * image's size (src/hough.c): the shear of every row, the row range of every intercept block,
  * the intercept -> r resampling. Computed once per context for every theta row when all of them
- * fit HOME_HOUGH_GEOMETRY_BYTES, else per row and frame into one scratch record. */
+ * fit HOME_HOUGH_GEOMETRY_BYTES, else per row and frame into one scratch record (the fast pass:
+ * as many rows as fit the configured pass's image buffers, which it does not use, cached there
+ * until the configured pass runs). */
 typedef struct home__theta_geom {
     int vertical, flip;               /* lines within 45 degrees of the columns; rows reversed */
     int s_min, s_max, j0, n, n_blocks; /* shift range, first intercept, intercepts, blocks */
     int i_lo, i_hi;                   /* r bins [i_lo, i_hi) fall inside the intercept range */
     float d_scale, end_scale;         /* J = d_scale (S(j+1) - S(j-1)) + end_scale [I] */
     int16_t *shift, *row_lo, *row_hi; /* per-row shear, per-block row ranges */
-    int32_t *first_row;               /* first row whose shift reaches a value */
     int16_t *entry, *after;           /* per intercept: first row inside the image, and the row
                                          after its last */
     int16_t *res_k;                   /* r bin i (from i_lo): intercept index k and weight */
@@ -115,8 +117,11 @@ typedef struct home__pass {
     uint32_t config_id;
     int r_bins, hough_w, hough_h, hough_scale;
     double hough_dx, hough_dy;
+    uint8_t *img_n, *img_t;
     ptrdiff_t img_n_stride, img_t_stride;
-    home__theta_geom *geom;           /* FAST: its theta rows' geometry, or NULL */
+    home__theta_geom *geom;           /* FAST: its first geom_rows raw theta rows' geometry */
+    int geom_rows;
+    int geom_borrowed;                /* geom lies in the configured pass's image buffers */
 } home__pass;
 
 struct home_context {
@@ -137,8 +142,15 @@ struct home_context {
     uint8_t *img_n, *img_t;           /* FAST: the image and its transpose, zero-padded by
                                          HOME__RADON_BLOCK columns on each side */
     ptrdiff_t img_n_stride, img_t_stride;
-    home__theta_geom *geom;           /* FAST: every raw theta row's geometry, or NULL */
+    home__theta_geom *geom;           /* FAST: the first geom_rows raw theta rows' geometry */
+    int geom_rows;
     home__theta_geom geom_scratch;    /* FAST: one row's, when not cached */
+    int32_t *first_row;               /* FAST: while computing a row's geometry, the first row
+                                         whose shift reaches a value */
+    int geom_borrowed;                /* the live pass's geom lies in the configured pass's
+                                         image buffers (the fast pass's, when its table does
+                                         not fit HOME_HOUGH_GEOMETRY_BYTES) ... */
+    int geom_stale;                   /* ... which the configured pass has overwritten since */
     int32_t *line_sum;                /* FAST: line sums over the intercept range */
     int32_t *edge_prefix;             /* FAST: prefix sums of the first and last column, per
                                          theta family and direction (src/hough.c) */
@@ -325,8 +337,16 @@ void home__refine_init(home_context *ctx, unsigned char *block);
 uint8_t *home__refine_half_frame(home_context *ctx, int *rows);
 void home__refine_half_rows(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int y0,
                             int y1);
-/* Snapshot of a frame; image NULL: the 2x2-mean frame was filled by home__refine_half_rows(). */
-uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride);
+/* Snapshot of a frame; image NULL: the 2x2-mean frame was filled by home__refine_half_rows().
+ * defer: its template points are selected only when needed (home__refine_settle), since a
+ * frame B is only ever registered to, never from, until another frame is stored. */
+uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int defer);
+/* Select a deferred slot's template points from the pyramid, which is still its frame's (slot:
+ * only that slot's; -1: any). Before anything replaces the pyramid or its scratch. */
+void home__refine_settle(home_context *ctx, int slot);
+/* Forget a deferred slot without selecting (the caller replaces both slots): its snapshot
+ * becomes unusable. */
+void home__refine_drop_pending(home_context *ctx);
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result);
 
 #endif

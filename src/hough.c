@@ -42,12 +42,14 @@ void home__hough_accumulate_row(const int16_t *gx, const int16_t *gy, int width,
 }
 
 static void prefix_edges(home_context *ctx);
+static void refill_geometry(home_context *ctx);
 
 void home__hough_load_rows(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int y0,
                            int y1)
 {
     const int width = ctx->hough_w, pad = HOME__RADON_BLOCK, ds = ctx->hough_scale;
     int y;
+    if (!ctx->geom_borrowed) ctx->geom_stale = 1; /* the configured pass: its buffers change */
     for (y = y0; y < y1; y++) {
         uint8_t *row = ctx->img_n + (ptrdiff_t)y * ctx->img_n_stride;
         memset(row, 0, (size_t)pad);
@@ -122,11 +124,11 @@ static void prefix_edges(home_context *ctx)
 }
 
 /* first row (in processing order) whose shift is >= v; shifts are nondecreasing */
-static int first_row_at(const home__theta_geom *g, int v, int rows)
+static int first_row_at(const home__theta_geom *g, const int32_t *first_row, int v, int rows)
 {
     if (v <= g->s_min) return 0;
     if (v > g->s_max) return rows;
-    return g->first_row[v - g->s_min];
+    return first_row[v - g->s_min];
 }
 
 void home__hough_raw_rows(const home_config *cfg, int radius, int *first, int *count)
@@ -146,6 +148,7 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
     const int flip = t < 0.0; /* process rows so that shifts are nondecreasing */
     const double centre = 0.5 * (rows - 1), inv_abs_a = 1.0 / fabs(a);
     const double t_processed = flip ? -t : t;
+    int32_t *first_row = ctx->first_row;
     int p, v, blk, n, j0, s_min, s_max;
 
     g->vertical = vertical;
@@ -159,36 +162,37 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
     s_min = g->s_min = g->shift[0];
     s_max = g->s_max = g->shift[rows - 1];
     /* first_row[v - s_min]: first row whose shift is >= v, for v in [s_min, s_max + 1] */
-    g->first_row[0] = 0;
+    first_row[0] = 0;
     for (p = 0, v = s_min + 1; v <= s_max; v++) {
         while (g->shift[p] < v) p++;
-        g->first_row[v - s_min] = p;
+        first_row[v - s_min] = p;
     }
-    g->first_row[s_max - s_min + 1] = rows;
+    first_row[s_max - s_min + 1] = rows;
     /* intercepts of every line touching the image, plus one on each side for S(j +- 1) */
     j0 = g->j0 = -s_max - 1;
     n = g->n = cols - s_min - j0 + 1;
     g->n_blocks = (n + HOME__RADON_BLOCK - 1) / HOME__RADON_BLOCK;
     for (blk = 0; blk < g->n_blocks; blk++) {
         int jb = j0 + blk * HOME__RADON_BLOCK;
-        g->row_lo[blk] = (int16_t)first_row_at(g, -jb - (HOME__RADON_BLOCK - 1), rows);
-        g->row_hi[blk] = (int16_t)(first_row_at(g, cols - jb, rows) - 1);
+        g->row_lo[blk] =
+            (int16_t)first_row_at(g, first_row, -jb - (HOME__RADON_BLOCK - 1), rows);
+        g->row_hi[blk] = (int16_t)(first_row_at(g, first_row, cols - jb, rows) - 1);
     }
     {
         /* each intercept's entry row (rows before it lie left of the image) and the row after
          * its exit (from there on right of it); lines through every row: 0 and rows */
         const int span = s_max - s_min + 1, in_span = span + 1 < n ? span + 1 : n;
         const int before_exit = cols < n ? cols : n;
-        const int16_t from_first = (int16_t)g->first_row[0], through_last =
-                                                              (int16_t)g->first_row[span];
+        const int16_t from_first = (int16_t)first_row[0], through_last =
+                                                              (int16_t)first_row[span];
         int i;
         /* with j0 = -s_max - 1, intercept i enters at shift value span - i (clamped at 0: from
          * the first row) and leaves at cols + span - i (clamped at span: through the last
          * row), never below 0 (n = cols + span): runs of one value and reversed copies */
-        for (i = 0; i < in_span; i++) g->entry[i] = (int16_t)g->first_row[span - i];
+        for (i = 0; i < in_span; i++) g->entry[i] = (int16_t)first_row[span - i];
         for (; i < n; i++) g->entry[i] = from_first;
         for (i = 0; i < before_exit; i++) g->after[i] = through_last;
-        for (; i < n; i++) g->after[i] = (int16_t)g->first_row[cols + span - i];
+        for (; i < n; i++) g->after[i] = (int16_t)first_row[cols + span - i];
     }
     g->d_scale = (float)(inv_abs_a / a);
     g->end_scale = (float)((flip ? -2.0 * b : 2.0 * b) * inv_abs_a); /* [I] in original row order */
@@ -289,10 +293,12 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
     int k, i, first_raw, n_raw;
 
     const int exact = ctx->cfg.hough_method == HOME_HOUGH_EXACT;
-    if (exact)
+    if (exact) {
         home__gradient(image, stride, width, height, ctx->grad_x, ctx->grad_y);
-    else
+    } else {
         prepare_fast(ctx, image, stride);
+        if (ctx->geom_borrowed && ctx->geom_stale) refill_geometry(ctx);
+    }
     home__hough_raw_rows(&ctx->cfg, radius, &first_raw, &n_raw);
     for (k = first_raw; k < first_raw + n_raw; k++) {
         const double theta = k * HOME__PI / n_theta;
@@ -306,8 +312,11 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
             for (i = 0; i < r_bins; i++)
                 ctx->row_tmp[i] = (float)(c * ctx->acc_x[i] + s * ctx->acc_y[i]);
         } else {
-            home__theta_geom *g = ctx->geom ? &ctx->geom[k - first_raw] : &ctx->geom_scratch;
-            if (!ctx->geom) home__theta_geometry(ctx, theta, g);
+            home__theta_geom *g = &ctx->geom_scratch;
+            if (k - first_raw < ctx->geom_rows)
+                g = &ctx->geom[k - first_raw];
+            else
+                home__theta_geometry(ctx, theta, g);
             fast_theta_row(ctx, g, ctx->row_tmp);
         }
         home__smooth_r(ctx->kernels, ctx->row_tmp, raw, r_bins, ctx->smooth_taps, radius);
@@ -341,12 +350,14 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
  * (every row's when it fits HOME_HOUGH_GEOMETRY_BYTES, else one scratch record), line sums,
  * border prefix sums and J over the intercepts. Both: one theta row's sums, the smoothing rings. */
 typedef struct hough_layout {
-    size_t grad_x, grad_y, img_n, img_t, geom, geom_scratch, line_sum, edge_prefix, line_j;
+    size_t grad_x, grad_y, img_n, img_t, img_end, geom, geom_scratch, first_row, line_sum,
+        edge_prefix, line_j;
     size_t acc_x, acc_y, raw_rows, smooth_rows, row_tmp, total;
     size_t geom_bytes;                /* one record's arrays */
     size_t geom_intercepts;           /* a row's intercepts, without the kernel's block slack */
     ptrdiff_t img_n_stride, img_t_stride;
     int geom_rows, geom_first;        /* raw theta rows cached (0: none) and the first's k */
+    int geom_rows_all;                /* raw theta rows */
     int geom_longest, geom_blocks;
 } hough_layout;
 
@@ -355,7 +366,6 @@ static size_t geom_record_bytes(int longest, int blocks, size_t intercepts, size
 {
     return home__align_up(((size_t)longest + 1) * sizeof(int16_t), 16) +
            2 * home__align_up((size_t)blocks * sizeof(int16_t), 16) +
-           home__align_up(((size_t)longest + 4) * sizeof(int32_t), 16) +
            2 * home__align_up(intercepts * sizeof(int16_t), 16) +
            home__align_up(r_bins * sizeof(int16_t), 16) +
            home__align_up(r_bins * sizeof(float), 16);
@@ -371,8 +381,6 @@ static void carve_geom(home__theta_geom *g, unsigned char *mem, int longest, int
     mem += home__align_up((size_t)blocks * sizeof(int16_t), 16);
     g->row_hi = (int16_t *)(void *)mem;
     mem += home__align_up((size_t)blocks * sizeof(int16_t), 16);
-    g->first_row = (int32_t *)(void *)mem;
-    mem += home__align_up(((size_t)longest + 4) * sizeof(int32_t), 16);
     g->entry = (int16_t *)(void *)mem;
     mem += home__align_up(intercepts * sizeof(int16_t), 16);
     g->after = (int16_t *)(void *)mem;
@@ -407,12 +415,14 @@ static void hough_plan(const home_config *cfg, hough_layout *l)
         l->img_t_stride = (ptrdiff_t)(h + 2 * HOME__RADON_BLOCK);
         l->img_n = home__take(&cur, h * (size_t)l->img_n_stride);
         l->img_t = home__take(&cur, w * (size_t)l->img_t_stride);
+        l->img_end = l->img_t + w * (size_t)l->img_t_stride;
         l->geom_longest = (int)longest;
         l->geom_blocks = (int)(intercepts / HOME__RADON_BLOCK + 1);
         l->geom_intercepts = w + h + 8;
         l->geom_bytes = geom_record_bytes(l->geom_longest, l->geom_blocks, l->geom_intercepts,
                                           r_bins);
         home__hough_raw_rows(cfg, (int)radius, &l->geom_first, &rows);
+        l->geom_rows_all = rows;
         bytes = home__align_up((size_t)rows * sizeof(home__theta_geom), 16) +
                 (size_t)rows * l->geom_bytes;
         if (bytes <= HOME_HOUGH_GEOMETRY_BYTES) {
@@ -421,6 +431,7 @@ static void hough_plan(const home_config *cfg, hough_layout *l)
         } else {
             l->geom_scratch = home__take(&cur, l->geom_bytes);
         }
+        l->first_row = home__take(&cur, (longest + 4) * sizeof(int32_t));
         l->line_sum = home__take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(int32_t));
         l->edge_prefix = home__take(&cur, 4 * 2 * (longest + 1) * sizeof(int32_t));
         l->line_j = home__take(&cur, (intercepts + HOME__RADON_BLOCK) * sizeof(float));
@@ -444,9 +455,13 @@ void home__select_pass(home_context *ctx, int k)
     ctx->hough_scale = p->hough_scale;
     ctx->hough_dx = p->hough_dx;
     ctx->hough_dy = p->hough_dy;
+    ctx->img_n = p->img_n;
+    ctx->img_t = p->img_t;
     ctx->img_n_stride = p->img_n_stride;
     ctx->img_t_stride = p->img_t_stride;
     ctx->geom = p->geom;
+    ctx->geom_rows = p->geom_rows;
+    ctx->geom_borrowed = p->geom_borrowed;
 }
 
 /* Bytes of a pass's cached theta geometry (0: none, rows computed one at a time) */
@@ -469,19 +484,54 @@ size_t home__hough_bytes(const home_config *cfg)
     return home__align_up(l.total + geom_table_bytes(&f), HOME__BLOCK_ALIGN);
 }
 
-/* The live pass's theta geometry: the records at table, then their arrays (l's sizes) */
-static void fill_geometry(home_context *ctx, unsigned char *table, const hough_layout *l)
+/* The live pass's theta geometry for its first `rows` raw theta rows: the records at table,
+ * then their arrays (l's sizes) */
+static void fill_geometry(home_context *ctx, unsigned char *table, const hough_layout *l, int rows)
 {
-    unsigned char *arrays =
-        table + home__align_up((size_t)l->geom_rows * sizeof(home__theta_geom), 16);
+    unsigned char *arrays = table + home__align_up((size_t)rows * sizeof(home__theta_geom), 16);
     int k;
     ctx->geom = (home__theta_geom *)(void *)table;
-    for (k = 0; k < l->geom_rows; k++) {
+    ctx->geom_rows = rows;
+    for (k = 0; k < rows; k++) {
         carve_geom(&ctx->geom[k], arrays + (size_t)k * l->geom_bytes, l->geom_longest,
                    l->geom_blocks, l->geom_intercepts, (size_t)ctx->r_bins);
         home__theta_geometry(ctx, (l->geom_first + k) * HOME__PI / ctx->cfg.theta_bins,
                              &ctx->geom[k]);
     }
+}
+
+/* The fast pass's borrowed geometry anew, after the configured pass overwrote it */
+static void refill_geometry(home_context *ctx)
+{
+    hough_layout l;
+    hough_plan(&ctx->cfg, &l);
+    fill_geometry(ctx, (unsigned char *)ctx->geom, &l, ctx->geom_rows);
+    ctx->geom_stale = 0;
+}
+
+/* The fast pass's buffers where the configured pass has its image buffers (which the fast pass
+ * does not otherwise use): its image and transpose first, then as many geometry records as fit
+ * the rest. block: the Hough block; l, f: the configured and the fast pass's layouts. */
+static void borrow_image_buffers(home_context *ctx, unsigned char *block, const hough_layout *l,
+                                 const hough_layout *f)
+{
+    home__pass *fast = &ctx->passes[1];
+    size_t at = l->img_n, record = sizeof(home__theta_geom) + f->geom_bytes, room;
+    int rows;
+    fast->img_n = block + at;
+    at = home__align_up(at + (size_t)fast->hough_h * (size_t)f->img_n_stride, HOME__BLOCK_ALIGN);
+    fast->img_t = block + at;
+    at = home__align_up(at + (size_t)fast->hough_w * (size_t)f->img_t_stride, HOME__BLOCK_ALIGN);
+    room = at + 16 < l->img_end ? l->img_end - at - 16 : 0; /* 16: the records' alignment */
+    rows = (int)(room / record < (size_t)f->geom_rows_all ? room / record
+                                                          : (size_t)f->geom_rows_all);
+    if (rows <= 0) return;
+    home__select_pass(ctx, 1);
+    fill_geometry(ctx, block + at, f, rows);
+    home__select_pass(ctx, 0);
+    fast->geom = (home__theta_geom *)(void *)(block + at);
+    fast->geom_rows = rows;
+    fast->geom_borrowed = 1;
 }
 
 void home__hough_init(home_context *ctx, unsigned char *block)
@@ -496,13 +546,15 @@ void home__hough_init(home_context *ctx, unsigned char *block)
     } else {
         ctx->img_n = block + l.img_n;
         ctx->img_t = block + l.img_t;
+        ctx->first_row = (int32_t *)(void *)(block + l.first_row);
         ctx->img_n_stride = l.img_n_stride;
         ctx->img_t_stride = l.img_t_stride;
         if (l.geom_rows) {
             /* records first, then their arrays; every row's geometry computed once, here */
-            fill_geometry(ctx, block + l.geom, &l);
+            fill_geometry(ctx, block + l.geom, &l, l.geom_rows);
         } else {
             ctx->geom = NULL;
+            ctx->geom_rows = 0;
             carve_geom(&ctx->geom_scratch, block + l.geom_scratch, l.geom_longest, l.geom_blocks,
                        l.geom_intercepts, (size_t)ctx->r_bins);
         }
@@ -515,22 +567,31 @@ void home__hough_init(home_context *ctx, unsigned char *block)
     ctx->raw_rows = (float *)(void *)(block + l.raw_rows);
     ctx->smooth_rows = (float *)(void *)(block + l.smooth_rows);
     ctx->row_tmp = (float *)(void *)(block + l.row_tmp);
+    ctx->passes[0].img_n = ctx->img_n;
+    ctx->passes[0].img_t = ctx->img_t;
     ctx->passes[0].img_n_stride = ctx->img_n_stride;
     ctx->passes[0].img_t_stride = ctx->img_t_stride;
     ctx->passes[0].geom = ctx->geom;
+    ctx->passes[0].geom_rows = ctx->geom_rows;
     if (ctx->n_passes > 1) {
-        /* the fast pass: its strides in the shared buffers, its own geometry after them (or
-         * the shared scratch record, which the configured pass's larger sizes carved) */
+        /* the fast pass: its strides in the shared buffers, its own geometry after them, or
+         * what fits in the configured pass's image buffers (the rest per row in the shared
+         * scratch record, which the configured pass's larger sizes carved) */
+        home__pass *fast = &ctx->passes[1];
         hough_layout f;
-        hough_plan(&ctx->passes[1].cfg, &f);
-        ctx->passes[1].img_n_stride = f.img_n_stride;
-        ctx->passes[1].img_t_stride = f.img_t_stride;
-        ctx->passes[1].geom = NULL;
-        home__select_pass(ctx, 1);
+        hough_plan(&fast->cfg, &f);
+        fast->img_n = ctx->img_n;
+        fast->img_t = ctx->img_t;
+        fast->img_n_stride = f.img_n_stride;
+        fast->img_t_stride = f.img_t_stride;
         if (f.geom_rows) {
-            fill_geometry(ctx, block + l.total, &f);
-            ctx->passes[1].geom = ctx->geom;
+            home__select_pass(ctx, 1);
+            fill_geometry(ctx, block + l.total, &f, f.geom_rows);
+            home__select_pass(ctx, 0);
+            fast->geom = (home__theta_geom *)(void *)(block + l.total);
+            fast->geom_rows = f.geom_rows;
+        } else {
+            borrow_image_buffers(ctx, block, &l, &f);
         }
-        home__select_pass(ctx, 0);
     }
 }

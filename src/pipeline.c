@@ -142,8 +142,8 @@ static int read_frame_once(home_context *ctx, const uint8_t *image, ptrdiff_t st
     return 1;
 }
 
-/* The features of a checked image; with snapshot, also the refinement's snapshot of it (else
- * frame_id and ms_refine are the caller's) */
+/* The features of a checked image; with snapshot (1, or 2: its template points deferred), also
+ * the refinement's snapshot of it (else frame_id and ms_refine are the caller's) */
 static void extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, home_features *out,
                     int snapshot)
 {
@@ -159,6 +159,7 @@ static void extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, h
     home__heap_init(&st.neg, ctx->heap_entries + ctx->cfg.keypoints_per_sign,
                     ctx->heap_items + ctx->cfg.keypoints_per_sign, ctx->cfg.keypoints_per_sign);
     t_read = home__now(ctx);
+    if (snapshot) home__refine_settle(ctx, -1); /* the last snapshot's pyramid is still there */
     read_once = read_frame_once(ctx, image, stride);
     t_read = home__now(ctx) - t_read; /* counted as the Hough stage's */
     out->ms_hough = t_read + home__hough_stream(ctx, read_once ? NULL : image, stride, on_row, &st);
@@ -178,7 +179,7 @@ static void extract(home_context *ctx, const uint8_t *image, ptrdiff_t stride, h
     out->ms_describe = st.ms_describe + (home__now(ctx) - t_end);
     if (snapshot) {
         t_end = home__now(ctx);
-        out->frame_id = home__refine_store(ctx, read_once ? NULL : image, stride);
+        out->frame_id = home__refine_store(ctx, read_once ? NULL : image, stride, snapshot == 2);
         out->ms_refine = home__now(ctx) - t_end;
     }
     out->width = ctx->cfg.width;
@@ -279,7 +280,7 @@ static void register_pass(home_context *ctx, const uint8_t *a, ptrdiff_t stride_
     reset_result(result);
     ctx->slots_valid = 0;
     extract(ctx, a, stride_a, &ctx->slots[0], snapshot);
-    extract(ctx, b, stride_b, &ctx->slots[1], snapshot);
+    extract(ctx, b, stride_b, &ctx->slots[1], snapshot ? 2 : 0); /* b's points: when needed */
     if (!snapshot) {
         ctx->slots[0].frame_id = id_a;
         ctx->slots[1].frame_id = id_b;
@@ -304,6 +305,8 @@ int home_register(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const
     if ((status = home__check_image(ctx, a, stride_a)) != HOME_OK) return status;
     if ((status = home__check_image(ctx, b, stride_b)) != HOME_OK) return status;
     memset(fast_ms, 0, sizeof fast_ms);
+    /* both snapshot slots are replaced: a deferred one is not worth selecting first */
+    home__refine_drop_pending(ctx);
     if (ctx->n_passes > 1) {
         /* the fast pass: its answer stands when ok and precise; else it only costs its time */
         home__select_pass(ctx, 1);

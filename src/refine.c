@@ -129,6 +129,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         result->refine_status = HOME_REFINE_NO_SNAPSHOT;
         return;
     }
+    home__refine_settle(ctx, slot); /* a frame registered to itself */
     has_estimate = result->ok || ((result->failure == HOME_FAIL_FEW_INLIERS ||
                                    result->failure == HOME_FAIL_UNCERTAIN) && result->inliers >= 8);
     trial = *result;
@@ -280,8 +281,8 @@ int home_refine(home_context *ctx, const uint8_t *a, ptrdiff_t stride_a, const u
     result->model = HOME_MODEL_HOMOGRAPHY;
     result->sigma_px = INFINITY; /* unknown: any refined estimate is more precise */
     t0 = home__now(ctx);
-    id_a = home__refine_store(ctx, a, stride_a);
-    id_b = home__refine_store(ctx, b, stride_b);
+    id_a = home__refine_store(ctx, a, stride_a, 0);
+    id_b = home__refine_store(ctx, b, stride_b, 1);
     result->ms[HOME_STAGE_REFINE] = home__now(ctx) - t0;
     home__refine_apply(ctx, id_a, id_b, result);
     result->ok = result->refined && result->ok;

@@ -147,6 +147,7 @@ void home__refine_init(home_context *ctx, unsigned char *block)
     home__refine_state *st = &ctx->refine;
     int l, s;
     memset(st, 0, sizeof *st);
+    st->pending_slot = -1;
     st->levels = ctx->cfg.refine_levels ? levels_for(&ctx->cfg) : 0;
     st->finest_level = st->levels ? finest_for(&ctx->cfg) : 0;
     st->base_level = st->levels ? base_for(&ctx->cfg) : 0;
@@ -457,13 +458,50 @@ void home__refine_half_rows(home_context *ctx, const uint8_t *image, ptrdiff_t s
                            half + (ptrdiff_t)y0 * st->w[1], st->w[1], st->w[1], y1 - y0);
 }
 
-uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride)
+/* The template points of slot `slot` (and its identity-test region points) from the current
+ * pyramid, which must be that slot's frame. Uses the scratch cells and rows. */
+static void select_templates(home__refine_state *st, int slot)
+{
+    int16_t *row_tmp = (int16_t *)st->scratch;
+    uint16_t *cells = scratch_cells(st);
+    int l;
+    /* the region points' level last: its block cells stay for them */
+    for (l = st->levels - 1; l >= st->finest_level; l--)
+        if (l != st->region_level)
+            select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells,
+                          &st->tpl[slot][l]);
+    l = st->region_level;
+    select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
+    select_region_points(st->pyr[l], st->w[l], st->h[l], l, cells, &st->regions[slot],
+                         st->region_faint[slot], st->region_plain[slot]);
+}
+
+void home__refine_settle(home_context *ctx, int slot)
+{
+    home__refine_state *st = &ctx->refine;
+    if (!st->levels || st->pending_slot < 0 || (slot >= 0 && slot != st->pending_slot)) return;
+    select_templates(st, st->pending_slot);
+    st->pending_slot = -1;
+}
+
+void home__refine_drop_pending(home_context *ctx)
+{
+    home__refine_state *st = &ctx->refine;
+    if (!st->levels || st->pending_slot < 0) return;
+    st->slot_id[st->pending_slot] = 0;
+    st->pending_slot = -1;
+}
+
+uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int defer)
 {
     home__refine_state *st = &ctx->refine;
     int l, slot;
     int16_t *row_tmp;
     uint16_t *cells;
     if (!st->levels) return 0; /* refinement off: no scratch (arithmetic on NULL is undefined) */
+    /* a deferred selection needs the pyramid about to be replaced (with image NULL the caller
+     * settled it before filling the 2x2-mean frame, which shares its scratch) */
+    if (image) home__refine_settle(ctx, -1);
     row_tmp = (int16_t *)st->scratch;
     cells = scratch_cells(st);
     if (st->base_level == 0) {
@@ -481,15 +519,10 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     st->pyr_id = hash_bytes(st->pyr[l], (size_t)st->w[l] * (size_t)st->h[l]);
     slot = st->next_slot;
     st->next_slot ^= 1;
-    /* the region points' level last: its block cells stay for them */
-    for (l = st->levels - 1; l >= st->finest_level; l--)
-        if (l != st->region_level)
-            select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells,
-                          &st->tpl[slot][l]);
-    l = st->region_level;
-    select_points(st->rk, st->pyr[l], st->w[l], st->h[l], l, row_tmp, cells, &st->tpl[slot][l]);
-    select_region_points(st->pyr[l], st->w[l], st->h[l], l, cells, &st->regions[slot],
-                         st->region_faint[slot], st->region_plain[slot]);
+    if (defer)
+        st->pending_slot = slot;
+    else
+        select_templates(st, slot);
     store_background(st, slot);
     st->slot_id[slot] = st->pyr_id;
     return st->pyr_id;

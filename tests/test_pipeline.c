@@ -213,13 +213,24 @@ void test_video_reuse_matches_pair(void)
     synth_corner_homography(&rng, IMG_W, IMG_H, 15, h);
     synth_render(SYNTH_STRUCTURED, 31, identity, 2.5, 1, img_a, IMG_W, IMG_H, IMG_W);
     synth_render(SYNTH_STRUCTURED, 31, h, 2.5, 2, img_b, IMG_W, IMG_H, IMG_W);
+    static home_features fb_pair;
+    home_result onward, onward_again;
     CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &pair), HOME_OK);
+    /* b's refinement points are selected only once another frame comes: b registered onward
+     * to it is refined as when b was extracted on its own */
+    memcpy(&fb_pair, home_last_features(ctx, 1), sizeof fb_pair);
+    CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &fa), HOME_OK);
+    CHECK_EQ_INT(home_match(ctx, &fb_pair, &fa, &onward), HOME_OK);
     CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &fa), HOME_OK);
     CHECK_EQ_INT(home_extract(ctx, img_b, IMG_W, &fb), HOME_OK);
     CHECK_EQ_INT(home_match(ctx, &fa, &fb, &video), HOME_OK);
     CHECK(pair.ok && video.ok);
     CHECK(memcmp(pair.H, video.H, sizeof pair.H) == 0);
     CHECK_EQ_INT(pair.inliers, video.inliers);
+    CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &fa), HOME_OK);
+    CHECK_EQ_INT(home_match(ctx, &fb, &fa, &onward_again), HOME_OK);
+    CHECK(onward.refined && onward_again.refined);
+    CHECK(memcmp(onward.H, onward_again.H, sizeof onward.H) == 0);
     {
         /* the same keypoints (entries past the counts are unspecified) */
         const home_features *cached = home_last_features(ctx, 1);

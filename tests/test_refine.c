@@ -179,6 +179,7 @@ void test_finest_level_half(void)
         printf("     textured p=%d: start 2 px off -> %.3f px ending at half size, %.3f px at full, "
                "%d iterations\n", 10 + 15 * k, err_half, err_full, res.refine_iterations);
         CHECK(res.refined);
+        home__refine_settle(ctx, -1); /* frame b's points: selected when needed */
         CHECK_EQ_INT(ctx->refine.tpl[0][0].n + ctx->refine.tpl[1][0].n, 0);
         CHECK(ctx->refine.tpl[0][1].n > 0 && ctx->refine.tpl[1][1].n > 0);
         CHECK_LT(err_half, 0.1);

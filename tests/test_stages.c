@@ -60,7 +60,6 @@ void test_hough_geometry_cache(void)
     static uint8_t a[640 * 360];
     static home_features cached, per_frame;
     static int16_t shift[4096], row_lo[256], row_hi[256], res_k[4 * 4096], entry[2 * 4096 + 8], after[2 * 4096 + 8];
-    static int32_t first_row[4096 + 8];
     static float res_f[4 * 4096];
     unsigned char *mem = (unsigned char *)(((uintptr_t)storage.b + 63) & ~(uintptr_t)63);
     home__theta_geom fresh, *geom;
@@ -75,7 +74,7 @@ void test_hough_geometry_cache(void)
     synth_render(SYNTH_STRUCTURED, 4, (const double[9]){1, 0, 0, 0, 1, 0, 0, 0, 1}, 2.5, 9, a, 640, 360, 640);
     CHECK_EQ_INT(home_extract(ctx, a, 640, &cached), HOME_OK);
     /* the cache still holds what home__theta_geometry computes */
-    fresh.shift = shift; fresh.row_lo = row_lo; fresh.row_hi = row_hi; fresh.first_row = first_row;
+    fresh.shift = shift; fresh.row_lo = row_lo; fresh.row_hi = row_hi;
     fresh.res_k = res_k; fresh.res_f = res_f; fresh.entry = entry; fresh.after = after;
     home__hough_raw_rows(&ctx->cfg, ctx->smooth_radius, &first, &rows);
     for (k = 0; k < rows; k++) {
@@ -87,7 +86,6 @@ void test_hough_geometry_cache(void)
                fresh.n_blocks != g->n_blocks || fresh.i_lo != g->i_lo || fresh.i_hi != g->i_hi ||
                fresh.d_scale != g->d_scale || fresh.end_scale != g->end_scale;
         bad += memcmp(fresh.shift, g->shift, (size_t)n_rows * sizeof *shift) != 0;
-        bad += memcmp(fresh.first_row, g->first_row, (size_t)(g->s_max - g->s_min + 2) * sizeof *first_row) != 0;
         bad += memcmp(fresh.row_lo, g->row_lo, (size_t)g->n_blocks * sizeof *row_lo) != 0;
         bad += memcmp(fresh.row_hi, g->row_hi, (size_t)g->n_blocks * sizeof *row_hi) != 0;
         bad += memcmp(fresh.res_k, g->res_k, (size_t)n_res * sizeof *res_k) != 0;
@@ -99,16 +97,46 @@ void test_hough_geometry_cache(void)
     /* the same context computing the geometry per frame into scratch arrays */
     geom = ctx->geom;
     ctx->geom = NULL;
+    ctx->geom_rows = 0;
     ctx->geom_scratch = fresh;
     CHECK_EQ_INT(home_extract(ctx, a, 640, &per_frame), HOME_OK);
     ctx->geom = geom;
+    ctx->geom_rows = rows;
     CHECK_EQ_INT(per_frame.n_pos + per_frame.n_neg, cached.n_pos + cached.n_neg);
     CHECK(per_frame.n_pos > 50);
     CHECK(memcmp(per_frame.kp, cached.kp, (size_t)(cached.n_pos + cached.n_neg) * sizeof *cached.kp) == 0);
-    /* the defaults' full-size transform needs more than the budget: computed per frame */
+    /* the defaults' full-size transform needs more than the budget: computed per frame; the
+     * fast pass's rows (240 theta bins of a 160 x 90 image) are cached where they fit, in the
+     * configured pass's image buffers, and computed anew after the configured pass ran */
     home_default_config(&cfg, 640, 360);
     CHECK_EQ_INT(home_init(&ctx, &cfg, mem, sizeof storage.b - 64, NULL), HOME_OK);
-    CHECK(ctx->geom == NULL);
+    CHECK(ctx->geom == NULL && ctx->geom_rows == 0);
+    home__hough_raw_rows(&ctx->passes[1].cfg, ctx->smooth_radius, &first, &rows);
+    CHECK(ctx->passes[1].geom_borrowed && ctx->passes[1].geom_rows > rows / 2);
+    {
+        static uint8_t b[640 * 360];
+        home_result before, after;
+        double h[9];
+        synth_rng rng;
+        synth_seed(&rng, 4);
+        synth_corner_homography(&rng, 640, 360, 12, h);
+        synth_render(SYNTH_STRUCTURED, 4, h, 2.5, 10, b, 640, 360, 640);
+        CHECK_EQ_INT(home_register(ctx, a, 640, b, 640, &before), HOME_OK);
+        CHECK_EQ_INT(home_extract(ctx, a, 640, &per_frame), HOME_OK); /* the configured pass */
+        CHECK_EQ_INT(home_register(ctx, a, 640, b, 640, &after), HOME_OK);
+        CHECK(before.ok && before.fast_pass && after.fast_pass);
+        CHECK(memcmp(before.H, after.H, sizeof before.H) == 0);
+    }
+    home__select_pass(ctx, 1);
+    for (k = 0, bad = 0; k < ctx->geom_rows; k++) {
+        const home__theta_geom *g = &ctx->geom[k];
+        home__theta_geometry(ctx, (first + k) * HOME__PI / ctx->cfg.theta_bins, &fresh);
+        bad += fresh.n != g->n || fresh.i_hi != g->i_hi || fresh.d_scale != g->d_scale ||
+               memcmp(fresh.entry, g->entry, (size_t)g->n * sizeof *entry) != 0 ||
+               memcmp(fresh.res_f, g->res_f, (size_t)(g->i_hi - g->i_lo) * sizeof *res_f) != 0;
+    }
+    home__select_pass(ctx, 0);
+    CHECK_EQ_INT(bad, 0);
 }
 
 void test_heap_keeps_top_k(void)
