@@ -43,7 +43,7 @@ static inline const uint8_t *home__stab_track_row(const uint8_t *src, ptrdiff_t 
 
 typedef struct home__stab_kernels {
     const char *name;
-    int block;                 /* output pixels per step of warp_row */
+    int block;                 /* output pixels per step of warp_row, a power of two */
     home__warp_row_fn warp_row;
 } home__stab_kernels;
 

@@ -290,7 +290,7 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
     const float *raw_window[2 * HOME__MAX_SMOOTH_RADIUS + 1];
     const float *window[HOME__DESC_ROWS];
     double t0 = home__now(ctx), spent = 0.0;
-    int k, i, first_raw, n_raw;
+    int k, i, first_raw, n_raw, slot, oldest;
 
     const int exact = ctx->cfg.hough_method == HOME_HOUGH_EXACT;
     if (exact) {
@@ -300,10 +300,11 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
         if (ctx->geom_borrowed && ctx->geom_stale) refill_geometry(ctx);
     }
     home__hough_raw_rows(&ctx->cfg, radius, &first_raw, &n_raw);
-    for (k = first_raw; k < first_raw + n_raw; k++) {
+    for (k = first_raw, slot = 0; k < first_raw + n_raw; k++) {
         const double theta = k * HOME__PI / n_theta;
-        float *raw = ctx->raw_rows + (size_t)((k - first_raw) % raw_ring) * r_bins;
+        float *raw = ctx->raw_rows + (size_t)slot * r_bins; /* slot = (k - first_raw) % ring */
         int j;
+        slot = slot + 1 < raw_ring ? slot + 1 : 0; /* from here on, the oldest row's */
         if (exact) {
             const double c = cos(theta), s = sin(theta);
             home__hough_accumulate_row(ctx->grad_x, ctx->grad_y, width, height,
@@ -323,9 +324,11 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
         if (k - first_raw < 2 * radius) continue;
 
         j = k - radius; /* the theta-smoothed row now complete */
-        for (i = 0; i < raw_ring; i++)
-            raw_window[i] = ctx->raw_rows +
-                            (size_t)((j - radius + i - first_raw) % raw_ring) * r_bins;
+        /* rows k - 2 radius .. k, the oldest (in the slot after k's) first */
+        for (i = 0, oldest = slot; i < raw_ring; i++) {
+            raw_window[i] = ctx->raw_rows + (size_t)oldest * r_bins;
+            oldest = oldest + 1 < raw_ring ? oldest + 1 : 0;
+        }
         home__smooth_theta(ctx->kernels, raw_window,
                            ctx->smooth_rows +
                                (size_t)((j - first_smooth) % HOME__DESC_ROWS) * r_bins,

@@ -154,7 +154,7 @@ static int fixed_profile(const uint8_t *a, int w, int h, int kind, int32_t *unit
 {
     const int units = kind == 0 ? w : kind == 1 ? h : w + h - 1;
     const int k = (units + PROFILE_BINS - 1) / PROFILE_BINS, bins = (units + k - 1) / k;
-    int x, y, i;
+    int x, y, i, bin, in_bin;
     if (units > UNIT_BINS_MAX) return 0;
     memset(unit, 0, (size_t)units * sizeof *unit);
     for (y = 0; y < h; y++) {
@@ -170,15 +170,19 @@ static int fixed_profile(const uint8_t *a, int w, int h, int kind, int32_t *unit
     }
     memset(sum, 0, PROFILE_BINS * sizeof *sum);
     memset(count, 0, PROFILE_BINS * sizeof *count);
-    for (i = 0; i < units; i++) {
-        /* pixels on unit line i: a column, a row, or a diagonal's run */
+    for (i = 0, bin = 0, in_bin = 0; i < units; i++) {
+        /* pixels on unit line i: a column, a row, or a diagonal's run; bin = i / k */
         const int len = kind == 0   ? h
                         : kind == 1 ? w
                         : i + 1 < w + h - 1 - i ? i + 1
                                                 : w + h - 1 - i;
         const int cap = w < h ? w : h;
-        sum[i / k] += (float)unit[i];
-        count[i / k] += (float)(kind < 2 ? len : len < cap ? len : cap);
+        sum[bin] += (float)unit[i];
+        count[bin] += (float)(kind < 2 ? len : len < cap ? len : cap);
+        if (++in_bin == k) {
+            in_bin = 0;
+            bin++;
+        }
     }
     n[0] = kind == 1 ? 0.0 : kind == 0 ? 1.0 : 0.7071067811865476;
     n[1] = kind == 0 ? 0.0 : kind == 1 ? 1.0 : kind == 2 ? 0.7071067811865476 : -0.7071067811865476;

@@ -50,10 +50,31 @@ typedef struct home__refine_solver {
 
 extern const double home__refine_identity[9];
 
-/* Region of a level pixel in the identity test's grid. */
+/* The identity test's grid on a w x h level: x * REGIONS_X / w by a multiply with m = 2^32 / w
+ * rounded up (armv7 has no divide instruction; a loop over pixels would call one per pixel).
+ * Exact: m w - 2^32 < w, so the product errs by less than x REGIONS_X / 2^32 < 1 / w. */
+typedef struct region_grid {
+    uint32_t mx, my;
+} region_grid;
+
+static inline region_grid region_grid_for(int w, int h)
+{
+    region_grid g;
+    g.mx = 0xffffffffu / (uint32_t)w + 1u;
+    g.my = 0xffffffffu / (uint32_t)h + 1u;
+    return g;
+}
+
+/* Region of a level pixel (0 <= x < w, 0 <= y < h) in the identity test's grid. */
+static inline int region_at(region_grid g, int x, int y)
+{
+    return (int)(((uint64_t)(uint32_t)(y * REGIONS_Y) * g.my) >> 32) * REGIONS_X +
+           (int)(((uint64_t)(uint32_t)(x * REGIONS_X) * g.mx) >> 32);
+}
+
 static inline int region_of(int x, int y, int w, int h)
 {
-    return (y * REGIONS_Y / h) * REGIONS_X + x * REGIONS_X / w;
+    return region_at(region_grid_for(w, h), x, y);
 }
 
 /* The acceptance test's error per point: Geman-McClure, bounded like the Cauchy weights'

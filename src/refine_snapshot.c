@@ -326,6 +326,7 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
     const int bw = (w + b - 1) / b, bh = (h + b - 1) / b;
     const int log2b = b == 4 ? 2 : b == 2 ? 1 : 0;
     const int floor_key = region_floor(level) << 4, weak_key = REGION_WEAK_SCORE << 4;
+    const region_grid grid = region_grid_for(w, h);
     int16_t key[REGION_CAPACITY];
     int bx, by, i, j, r, n = 0;
     for (i = 0; i < REGION_CAPACITY; i++) key[i] = 0;
@@ -336,7 +337,7 @@ static void select_region_points(const uint8_t *img, int w, int h, int level,
             if (k < weak_key) continue;
             x = bx * b + (k & (b - 1));
             y = by * b + ((k & 15) >> log2b);
-            r = region_of(x, y, w, h) * REGION_TOP;
+            r = region_at(grid, x, y) * REGION_TOP;
             if (k <= key[r + REGION_TOP - 1]) continue;
             /* insert, strongest first; an equal key keeps the earlier block ahead */
             for (j = REGION_TOP - 1; j > 0 && key[r + j - 1] < k; j--) {

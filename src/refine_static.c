@@ -41,6 +41,7 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
     const home__refine_points *tp;
     float m[9];
     home__refine_solver s;
+    region_grid grid;
     *clear_share = 0.0;
     *against = 0;
     if (still) memset(still, 0, REGIONS_X * REGIONS_Y);
@@ -73,9 +74,10 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
     }
     memset(cost, 0, sizeof cost);
     memset(count, 0, sizeof count);
+    grid = region_grid_for(st->w[fl], st->h[fl]);
     for (i = 0; i < tp->n; i++) {
         if (s.img_b[i] < 0.0f || s.img_b2[i] < 0.0f) continue;
-        r = region_of(tp->x[i], tp->y[i], st->w[fl], st->h[fl]);
+        r = region_at(grid, tp->x[i], tp->y[i]);
         count[r]++;
         for (e = 0; e < 2; e++) {
             const double v = e ? s.img_b2[i] : s.img_b[i];

@@ -91,7 +91,7 @@ void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t s
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
-    body = n - n % k->block;
+    body = n & ~(k->block - 1); /* a power of two: no division (armv7 has none) */
     if (body > 0) k->warp_row(src, stride, w, x0, y0, dx, dy, dst, body);
     if (body < n) /* inside too: the reference's fast path */
         home__warp_row_c(src, stride, 1, w, h,

@@ -5,6 +5,7 @@
 #include "test.h"
 #include "synth.h"
 #include "home_internal.h"
+#include "refine_internal.h"
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -126,6 +127,19 @@ static void textured_refines(home_context *ctx, int pairs, double max_err)
         CHECK(res.refined);
         CHECK_LT(err, max_err);
     }
+}
+
+/* The identity test's grid without a division: the same regions as x * 8 / w and y * 6 / h
+ * for every level size up to HOME_MAX_SIDE and every pixel. */
+void test_region_grid_exact(void)
+{
+    int w, x, bad = 0;
+    for (w = 1; w <= HOME_MAX_SIDE; w++) {
+        const region_grid g = region_grid_for(w, w);
+        for (x = 0; x < w; x++)
+            bad += region_at(g, x, x) != (x * REGIONS_Y / w) * REGIONS_X + x * REGIONS_X / w;
+    }
+    CHECK_EQ_INT(bad, 0);
 }
 
 void test_textured_subpixel(void)
@@ -581,7 +595,7 @@ void test_refine_bad_inputs(void)
 }
 
 #define TEST_LIST(X) \
-    X(kernels_match_references) X(arena_and_config) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
+    X(kernels_match_references) X(arena_and_config) X(region_grid_exact) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
     X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
