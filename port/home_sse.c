@@ -45,8 +45,32 @@ void home__nearest2_l1_sse(const uint8_t *query, const uint8_t *cands, ptrdiff_t
                             int *best, int *d1, int *d2)
 {
     const __m128i q = _mm_loadu_si128((const __m128i *)(const void *)query);
-    int j, b = -1, m1 = 1 << 30, m2 = 1 << 30;
-    for (j = 0; j < n; j++) {
+    int j = 0, k, b = -1, m1 = 1 << 30, m2 = 1 << 30;
+    /* four candidates per step, looked at one by one (in order, as below) only when one of
+     * them is closer than the second best: once those two are small, hardly ever */
+    for (; j + 4 <= n; j += 4) {
+        const uint8_t *c = cands + (ptrdiff_t)j * stride;
+        const __m128i s0 = _mm_sad_epu8(q, _mm_loadu_si128((const __m128i *)(const void *)c)),
+                      s1 = _mm_sad_epu8(
+                          q, _mm_loadu_si128((const __m128i *)(const void *)(c + stride))),
+                      s2 = _mm_sad_epu8(
+                          q, _mm_loadu_si128((const __m128i *)(const void *)(c + 2 * stride))),
+                      s3 = _mm_sad_epu8(
+                          q, _mm_loadu_si128((const __m128i *)(const void *)(c + 3 * stride)));
+        /* each candidate's two partial sums added: d0, d1 in the low halves of s01, ... */
+        const __m128i s01 = _mm_add_epi32(_mm_unpacklo_epi64(s0, s1), _mm_unpackhi_epi64(s0, s1)),
+                      s23 = _mm_add_epi32(_mm_unpacklo_epi64(s2, s3), _mm_unpackhi_epi64(s2, s3));
+        const __m128i d = _mm_castps_si128(_mm_shuffle_ps(
+            _mm_castsi128_ps(s01), _mm_castsi128_ps(s23), _MM_SHUFFLE(2, 0, 2, 0)));
+        int dist[4];
+        if (!_mm_movemask_epi8(_mm_cmplt_epi32(d, _mm_set1_epi32(m2)))) continue;
+        _mm_storeu_si128((__m128i *)(void *)dist, d);
+        for (k = 0; k < 4; k++) {
+            if (dist[k] < m1) { m2 = m1; m1 = dist[k]; b = j + k; }
+            else if (dist[k] < m2) m2 = dist[k];
+        }
+    }
+    for (; j < n; j++) {
         __m128i c = _mm_loadu_si128((const __m128i *)(const void *)(cands + (ptrdiff_t)j * stride));
         __m128i sad = _mm_sad_epu8(q, c);  /* two 64-bit partial sums */
         int d = _mm_cvtsi128_si32(_mm_add_epi32(sad, _mm_srli_si128(sad, 8)));

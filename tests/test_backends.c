@@ -162,6 +162,7 @@ void test_kernels_nearest(void)
         for (i = 0; i < N * STRIDE; i++) cands[i] = random_byte(&rng, trial % 7 == 0);
         for (i = 0; i < 17; i++) query[i] = random_byte(&rng, trial % 7 == 0);
         if (trial % 3 == 0) memcpy(cands + 5 * STRIDE + 1, cands + 2 * STRIDE + 1, 16); /* a tie */
+        if (trial % 3 == 1) memcpy(cands + 3 * STRIDE + 1, cands + 2 * STRIDE + 1, 16); /* in a group of four */
         home__kernels_scalar.nearest2_l1(query + trial % 2, cands + 1, STRIDE, n, &wb, &wd1, &wd2);
         for (bi = 0; bi < sizeof backends / sizeof backends[0]; bi++) {
             const home__kernels *k = home__kernels_for(backends[bi]);
