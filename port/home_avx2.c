@@ -154,10 +154,51 @@ static void box_down_avx2(const uint8_t *src, ptrdiff_t stride, int ds, uint8_t 
     if (x < out_w) home__box_down_sse(src + ds * x, stride, ds, out + x, out_w - x);
 }
 
+/* Eight candidates per step (j..j+3 in the low 128-bit lanes, j+4..j+7 in the high ones), looked
+ * at one by one in order only when one is closer than the second best; as the SSE2 kernel. */
+static void nearest2_l1_avx2(const uint8_t *query, const uint8_t *cands, ptrdiff_t stride, int n,
+                             int *best, int *d1, int *d2)
+{
+    const __m128i q1 = _mm_loadu_si128((const __m128i *)(const void *)query);
+    const __m256i q = _mm256_broadcastsi128_si256(q1);
+    int j = 0, k, b = -1, m1 = 1 << 30, m2 = 1 << 30;
+#define CAND(i) _mm_loadu_si128((const __m128i *)(const void *)(c + (i) * stride))
+#define SAD_PAIR(i) \
+    _mm256_sad_epu8(q, _mm256_inserti128_si256(_mm256_castsi128_si256(CAND(i)), CAND((i) + 4), 1))
+    for (; j + 8 <= n; j += 8) {
+        const uint8_t *c = cands + (ptrdiff_t)j * stride;
+        const __m256i s0 = SAD_PAIR(0), s1 = SAD_PAIR(1), s2 = SAD_PAIR(2), s3 = SAD_PAIR(3);
+        /* per 128-bit lane: d0, d1 in the low halves of s01's 64-bit words, d2, d3 in s23's */
+        const __m256i s01 = _mm256_add_epi32(_mm256_unpacklo_epi64(s0, s1),
+                                             _mm256_unpackhi_epi64(s0, s1)),
+                      s23 = _mm256_add_epi32(_mm256_unpacklo_epi64(s2, s3),
+                                             _mm256_unpackhi_epi64(s2, s3));
+        const __m256i d = _mm256_castps_si256(_mm256_shuffle_ps(
+            _mm256_castsi256_ps(s01), _mm256_castsi256_ps(s23), _MM_SHUFFLE(2, 0, 2, 0)));
+        int dist[8];
+        if (!_mm256_movemask_epi8(_mm256_cmpgt_epi32(_mm256_set1_epi32(m2), d))) continue;
+        _mm256_storeu_si256((__m256i *)(void *)dist, d);
+        for (k = 0; k < 8; k++) {
+            if (dist[k] < m1) { m2 = m1; m1 = dist[k]; b = j + k; }
+            else if (dist[k] < m2) m2 = dist[k];
+        }
+    }
+#undef SAD_PAIR
+#undef CAND
+    for (; j < n; j++) {
+        const __m128i sad = _mm_sad_epu8(
+            q1, _mm_loadu_si128((const __m128i *)(const void *)(cands + (ptrdiff_t)j * stride)));
+        const int dist = _mm_cvtsi128_si32(_mm_add_epi32(sad, _mm_srli_si128(sad, 8)));
+        if (dist < m1) { m2 = m1; m1 = dist; b = j; }
+        else if (dist < m2) m2 = dist;
+    }
+    *best = b; *d1 = m1; *d2 = m2;
+}
+
 const home__kernels home__kernels_avx2 = {
     .name = "avx2",
     .radon_blocks = radon_blocks_avx2,
-    .nearest2_l1 = home__nearest2_l1_sse,
+    .nearest2_l1 = nearest2_l1_avx2,
     .smooth_row = smooth_row_fv,
     .smooth_cols = smooth_cols_fv,
     .box_down = box_down_avx2,
