@@ -108,7 +108,7 @@ void test_video_config(void)
     CHECK_EQ_INT(home_video_config(&cfg, IMG_W, IMG_H), HOME_OK);
     CHECK_EQ_INT(home_validate_config(&cfg), HOME_OK);
     CHECK_EQ_INT(cfg.hough_downscale, 4);
-    /* 1.39 MB with the cached theta geometry (0.39 MB); issue 4's bound is 2 MiB */
+    /* 1.25 MB with the cached theta geometry; issue 4's bound is 2 MiB */
     CHECK(home_arena_size(&cfg) < (size_t)3 << 19);
     CHECK_EQ_INT(home_video_config(&cfg, 320, 180), HOME_OK);
     CHECK_EQ_INT(cfg.hough_downscale, 2);
