@@ -139,7 +139,7 @@ typedef struct app {
 static const char *status_name(int s)
 {
     static const char *names[] = {"first", "ok", "failed", "implausible", "cut",
-                                  "still", "restored"};
+                                  "still", "restored", "partial"};
     return s >= 0 && s < (int)(sizeof names / sizeof names[0]) ? names[s] : "?";
 }
 

@@ -123,10 +123,13 @@ enum home_stab_motion_status {
     HOME_STAB_MOTION_CUT,       /* a scene cut (or home_stab_cut()): the path restarts here */
     HOME_STAB_MOTION_STILL,     /* a small motion among frames registered as the identity (a
                                    still camera): taken as none */
-    HOME_STAB_MOTION_RESTORED   /* a motion HOME refused because the frame's plain background
+    HOME_STAB_MOTION_RESTORED,  /* a motion HOME refused because the frame's plain background
                                    stood still, taken because the frames around it register a
                                    moving camera (a plain part moving with the camera: a hand at
                                    the lens, blocks an encoder left unchanged) */
+    HOME_STAB_MOTION_PARTIAL    /* too little structure for a whole motion (a horizon in fog):
+                                   the shift the frames determine (across the horizon), none
+                                   along it and no rotation */
 };
 
 /* A similarity about the image centre c: p -> exp(log_scale) R(angle) (p - c) + c + (tx, ty). */

@@ -348,5 +348,10 @@ void home__refine_settle(home_context *ctx, int slot);
  * becomes unusable. */
 void home__refine_drop_pending(home_context *ctx);
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result);
+/* Frame a -> b (snapshot ids, b the latest) as far as the frames determine a translation, from
+ * the identity, none in the other directions (a horizon in fog: the shift across it; src/
+ * refine_solve.c, home__refine_determined): 1 with h and its predicted error (full-size px). */
+int home__refine_determined_motion(home_context *ctx, uint32_t id_a, uint32_t id_b, double *h,
+                                   double *sigma_px);
 
 #endif

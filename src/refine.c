@@ -114,6 +114,16 @@ static int find_slot(const home__refine_state *st, uint32_t id)
     return -1;
 }
 
+int home__refine_determined_motion(home_context *ctx, uint32_t id_a, uint32_t id_b, double *h,
+                                   double *sigma_px)
+{
+    home__refine_state *st = &ctx->refine;
+    const int slot = find_slot(st, id_a);
+    if (!st->levels || slot < 0 || st->pyr_id != id_b || !id_b) return 0;
+    home__refine_settle(ctx, slot);
+    return home__refine_determined(ctx, slot, h, sigma_px);
+}
+
 /* Failure rule with the refinement (documented in home.h at home_match). */
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
 {

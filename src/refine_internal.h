@@ -116,6 +116,12 @@ double home__refine_run_without(home_context *ctx, int slot, const double *h0,
 void home__refine_probe(home_context *ctx, int slot, const double *h0, const double *back,
                         double radius, home_result *result);
 
+/* The stabiliser's fallback where a frame holds too little structure for a motion (a horizon
+ * in fog): from the identity, only the directions of a translation that the data determine
+ * (src/refine_solve.c), none in the others. 1 with h (A -> B pixels) and its predicted error
+ * when it converged, determines something and fits B better than the identity. */
+int home__refine_determined(home_context *ctx, int slot, double *h, double *sigma_px);
+
 /* refine_static.c */
 /* h (full-size pixels) as a map of background pixels, into m. */
 void home__refine_background_matrix(const home__refine_state *st, const double *h, double *m);

@@ -18,6 +18,10 @@
  * the residual variance (two frames' noise) times this; taking each block's strongest
  * gradient raises it above 1 (3: the tuning set's calibration, docs/trust.md) */
 #define NOISE_GRADIENT_SHARE 3.0
+#define DETERMINED_STD_PX 0.25 /* home__refine_determined(): a direction of the translation is
+                                  solved when its standard deviation (without the noise's
+                                  apparent information) is at most this, full-size px at the
+                                  finest level (twice per coarser level) */
 #define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
                                   (calibrated on the evaluation's tuning set: neighbouring
                                   template points do not carry independent noise) */
@@ -281,13 +285,16 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
  * contributes on average: var(g) sum w D^T D, D the warp's 2x8 Jacobian at each point,
  * D = [u v 1 0 0 0 -u^2 -uv; 0 0 0 u v 1 -uv -v^2]: its entries are the weighted moments
  * m[a][b] = sum w u^a v^b up to degree 4. */
-static void remove_noise_information(home__refine_solver *s)
+/* var(g) sum w D^T D at `level` (its template points, the weights of its last iteration) for
+ * the residual variance resid_var, into b (normalised units, as jtj). */
+static void noise_information(const home__refine_solver *s, int level, double resid_var,
+                              double *b)
 {
-    const home__refine_points *tp = &s->tpl[s->finest];
-    const double sc = (double)(1 << s->finest), o = 0.5 * (sc - 1.0);
+    const home__refine_points *tp = &s->tpl[level];
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
     const double k = s->f / (2.0 * sc);
-    const double var_g = NOISE_GRADIENT_SHARE * s->resid_var * k * k;
-    double m[5][5], b[64];
+    const double var_g = NOISE_GRADIENT_SHARE * resid_var * k * k;
+    double m[5][5];
     int i, p, q;
     memset(m, 0, sizeof m);
     for (i = 0; i < tp->n; i++) {
@@ -301,7 +308,7 @@ static void remove_noise_information(home__refine_solver *s)
             for (c = 0; a + c <= 4; c++, wuv *= v) m[a][c] += wuv;
         }
     }
-    memset(b, 0, sizeof b);
+    memset(b, 0, 64 * sizeof *b);
     b[0 * 8 + 0] = b[3 * 8 + 3] = m[2][0];
     b[0 * 8 + 1] = b[3 * 8 + 4] = m[1][1];
     b[0 * 8 + 2] = b[3 * 8 + 5] = m[1][0];
@@ -319,17 +326,26 @@ static void remove_noise_information(home__refine_solver *s)
     b[6 * 8 + 7] = m[3][1] + m[1][3];
     b[7 * 8 + 7] = m[2][2] + m[0][4];
     for (p = 0; p < 8; p++)
+        for (q = p; q < 8; q++) b[p * 8 + q] = b[q * 8 + p] = var_g * b[p * 8 + q];
+}
+
+static void remove_noise_information(home__refine_solver *s)
+{
+    double b[64];
+    int p, q;
+    noise_information(s, s->finest, s->resid_var, b);
+    for (p = 0; p < 8; p++)
         for (q = p; q < 8; q++) {
-            s->jtj[p * 8 + q] -= var_g * b[p * 8 + q];
+            s->jtj[p * 8 + q] -= b[p * 8 + q];
             s->jtj[q * 8 + p] = s->jtj[p * 8 + q];
         }
 }
 
-/* Weighted residual variance of the last iteration (its weights and residuals are still in the
- * scratch), for the Fisher covariance below. */
-static double residual_variance(const home__refine_solver *s)
+/* Weighted residual variance of the last iteration at `level` (its weights and residuals are
+ * still in the scratch), for the Fisher covariance below; residual_variance(): the finest's. */
+static double residual_variance_at(const home__refine_solver *s, int level)
 {
-    const home__refine_points *tp = &s->tpl[s->finest];
+    const home__refine_points *tp = &s->tpl[level];
     double sum_w = 0, sum_wr2 = 0;
     int i;
     for (i = 0; i < tp->n; i++) {
@@ -337,6 +353,11 @@ static double residual_variance(const home__refine_solver *s)
         sum_wr2 += (double)s->wt[i] * s->res[i] * s->res[i];
     }
     return sum_w > 8 ? sum_wr2 / (sum_w - 8) : sum_wr2;
+}
+
+static double residual_variance(const home__refine_solver *s)
+{
+    return residual_variance_at(s, s->finest);
 }
 
 /* Predicted standard deviation of the worst corner, px: sqrt(J_c (sigma^2 A^-1) J_c^T). */
@@ -679,6 +700,160 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
     result->refined = 1;
     result->refine_status = HOME_REFINE_ACCEPTED;
     return 0.0;
+}
+
+/* Eigen-decomposition of the symmetric n x n matrix a (row stride 8, destroyed: its diagonal
+ * becomes the eigenvalues) by cyclic Jacobi rotations; v's rows the eigenvectors. */
+static void jacobi_eigen(double *a, int n, double v[8][8])
+{
+    int sweep, p, q, r;
+    for (p = 0; p < n; p++)
+        for (q = 0; q < n; q++) v[p][q] = p == q ? 1.0 : 0.0;
+    for (sweep = 0; sweep < 32; sweep++) {
+        double off = 0.0, diag = 0.0;
+        for (p = 0; p < n; p++) {
+            diag += a[p * 8 + p] * a[p * 8 + p];
+            for (q = p + 1; q < n; q++) off += a[p * 8 + q] * a[p * 8 + q];
+        }
+        if (!(off > 1e-30 * diag)) return;
+        for (p = 0; p < n; p++)
+            for (q = p + 1; q < n; q++) {
+                const double apq = a[p * 8 + q];
+                double theta, t, c, sn;
+                if (apq == 0.0) continue;
+                theta = (a[q * 8 + q] - a[p * 8 + p]) / (2.0 * apq);
+                t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                c = 1.0 / sqrt(t * t + 1.0);
+                sn = t * c;
+                for (r = 0; r < n; r++) { /* columns p, q, then rows p, q */
+                    const double arp = a[r * 8 + p], arq = a[r * 8 + q];
+                    a[r * 8 + p] = c * arp - sn * arq;
+                    a[r * 8 + q] = sn * arp + c * arq;
+                }
+                for (r = 0; r < n; r++) {
+                    const double apr = a[p * 8 + r], aqr = a[q * 8 + r];
+                    a[p * 8 + r] = c * apr - sn * aqr;
+                    a[q * 8 + r] = sn * apr + c * aqr;
+                }
+                for (r = 0; r < n; r++) {
+                    const double vp = v[p][r], vq = v[q][r];
+                    v[p][r] = c * vp - sn * vq;
+                    v[q][r] = sn * vp + c * vq;
+                }
+            }
+    }
+}
+
+/* The directions of the translation the data at `level` determine, about s->hn: s->basis and
+ * s->k become them (a smaller model whose updates never leave it). The level's normal matrix,
+ * without the noise's apparent information, is decomposed; a direction is kept when its
+ * standard deviation is at most DETERMINED_STD_PX (times 2^level). A translation moves every
+ * pixel alike, so that is px anywhere in the frame (a similarity's tilt, tried on a horizon,
+ * came out no better than none at a predicted fraction of a px: docs/stabiliser.md). 0: none,
+ * or too few points. */
+static int determined_subspace(home__refine_solver *s, int level)
+{
+    const home__refine_state *st = s->st;
+    const home__refine_points *tp = &s->tpl[level];
+    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const double k = s->f / (2.0 * sc);
+    const double limit = DETERMINED_STD_PX * sc / s->f; /* normalised units */
+    double shift[8][8], o8[8], a[64], g[8], noise[64], aq[64], unused[8], v[8][8], var;
+    float m[9], aff[3];
+    int i, j, kept = 0;
+    const int n = home__model_basis(HOME__SPACE_H, HOME_MODEL_TRANSLATION, o8, shift);
+    home__refine_level_matrix(s, s->hn, level, m);
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level], st->h[level],
+                 s->img_b);
+    s->sigma = home__refine_robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta,
+                                         (int32_t *)(void *)s->wt);
+    if (home__refine_fit_photometric(s, tp, s->img_b, NULL, s->sigma, s->res, s->wt) < MIN_POINTS)
+        return 0;
+    aff[0] = (float)(sc / s->f);
+    aff[1] = (float)((o - s->cx) / s->f);
+    aff[2] = (float)((o - s->cy) / s->f);
+    st->rk->accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff, 1, s->acc);
+    s->hessian_level = level;
+    normal_equations(s->acc, 0xf, k, a, g);
+    var = residual_variance_at(s, level);
+    noise_information(s, level, var, noise);
+    for (i = 0; i < 64; i++) a[i] -= noise[i];
+    home__project_normal((const double(*)[8])shift, n, a, g, aq, unused);
+    jacobi_eigen(aq, n, v);
+    memset(s->basis, 0, sizeof s->basis);
+    for (i = 0; i < n; i++) {
+        /* standard deviation along eigenvector i: sqrt(var / lambda) */
+        if (!(aq[i * 8 + i] > 0.0) || var / aq[i * 8 + i] > limit * limit) continue;
+        for (j = 0; j < n; j++) {
+            int e;
+            for (e = 0; e < 8; e++) s->basis[kept][e] += v[i][j] * shift[j][e];
+        }
+        kept++;
+    }
+    s->k = kept;
+    return kept > 0;
+}
+
+int home__refine_determined(home_context *ctx, int slot, double *h, double *sigma_px)
+{
+    const home__refine_state *st = &ctx->refine;
+    home__refine_solver s;
+    double h1[9], step = INFINITY, e0, e1, zncc, sigma0;
+    int level, it, converged = 0;
+    home__refine_solver_setup(ctx, slot, &s);
+    home__refine_to_normalised(&s, home__refine_identity, s.hn);
+    for (level = s.finest; level < st->levels; level++)
+        if (s.tpl[level].n < MIN_POINTS) return 0;
+    for (level = st->levels - 1; level >= s.finest; level--) {
+        double noise_std = -1.0, last_step = INFINITY;
+        if (!determined_subspace(&s, level)) return 0;
+        s.hessian_level = -1;
+        converged = 0;
+        /* a horizon in fog is blurred: its steps shrink slowly (up to four times the
+         * refinement's iterations per level) */
+        for (it = 0; it < 4 * ctx->cfg.refine_iterations; it++) {
+            if (!iterate(&s, level, &step)) return 0;
+            if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
+            /* as refine_run(): at the finest level, steps far below the predicted error */
+            if (level == s.finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
+                if (!(noise_std >= 0.0)) {
+                    s.resid_var = residual_variance(&s);
+                    noise_std = corner_std_px(&s);
+                }
+                if (step < STEP_NOISE_SHARE * noise_std) { converged = 1; break; }
+            }
+            if (step > 0.5 * last_step) s.hessian_level = -1; /* as refine_run(): fresh */
+            last_step = step;
+        }
+    }
+    if (!converged) return 0;
+    to_pixels(&s, s.hn, h1);
+    if (!home__homography_plausible(h1, ctx->cfg.width, ctx->cfg.height)) return 0;
+    s.resid_var = residual_variance(&s);
+    remove_noise_information(&s);
+    *sigma_px = REFINE_SIGMA_SCALE * corner_std_px(&s);
+    if (!(*sigma_px <= DETERMINED_STD_PX * 2.0)) return 0;
+    {
+        /* the estimate explains frame B better than the identity does */
+        const home__refine_points *tp = &s.tpl[s.finest];
+        const int n4 = (tp->n + LANES - 1) & ~(LANES - 1), fl = s.finest;
+        float m[9];
+        home__refine_level_matrix(&s, s.hn, fl, m);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
+        home__refine_level_matrix(&s, home__refine_identity, fl, m);
+        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
+        s.alpha = 1.0;
+        s.beta = 0.0;
+        home__refine_fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
+        sigma0 = home__refine_robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta,
+                                           (int32_t *)(void *)s.wt);
+        e0 = photometric_error(&s, s.img_b, s.img_b2, sigma0, &zncc);
+        e1 = photometric_error(&s, s.img_b2, s.img_b, sigma0, &zncc);
+        if (!(e1 < e0)) return 0;
+    }
+    memcpy(h, h1, sizeof h1);
+    return 1;
 }
 
 double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)

@@ -3,6 +3,7 @@
  * crop-window constraint, hold-on-failure. See include/home_stab.h for the contract. This file:
  * configuration and arena, frames in (registration at the chosen size) and out (the crop
  * window); the similarities are in stab_motion.c, the path's filter in stab_path.c. */
+#include "home_internal.h" /* home__refine_determined_motion() */
 #include "home_stab.h"
 #include "kernels.h"
 #include "stab_internal.h"
@@ -407,6 +408,21 @@ static int plausible_motion(const home_stab *st, const home_result *reg, home_st
     return 1;
 }
 
+/* A frame with too little structure for HOME (few lines, no refinement to vouch: a horizon in
+ * fog) still determines part of its motion: that part, when plausible (1). Not for frames
+ * refused for what they show (moving objects, a pattern), only for what they lack. */
+static int partial_motion(const home_stab *st, const home_result *reg, home_stab_sim *motion,
+                          double *weight)
+{
+    home_result part;
+    if (reg->failure != HOME_FAIL_FEW_INLIERS) return 0;
+    memset(&part, 0, sizeof part);
+    if (!home__refine_determined_motion(st->home, st->feat[0]->frame_id, st->feat[1]->frame_id,
+                                        part.H, &part.sigma_px))
+        return 0;
+    return plausible_motion(st, &part, motion, weight);
+}
+
 static int check_stab(const home_stab *st, const home_stab_output *out)
 {
     if (!st || !out) return HOME_E_NULL;
@@ -446,6 +462,8 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
                 out->newest_status = HOME_STAB_MOTION_OK;
         } else if (out->reg.refine_status == HOME_REFINE_STILL_BACKGROUND) {
             has_candidate = plausible_motion(st, &out->reg, &candidate, &candidate_weight);
+        } else if (partial_motion(st, &out->reg, &motion, &weight)) {
+            out->newest_status = HOME_STAB_MOTION_PARTIAL;
         }
     }
     swap = st->feat[0];
