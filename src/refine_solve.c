@@ -560,6 +560,37 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
     }
 }
 
+/* Robust photometric errors e0 of the estimate hn0 and e1 of hn (both normalised) at the finest
+ * level over the points both keep (and not in an excluded region), at hn0's residual scale, and
+ * their correlations; img_b holds B under hn0, img_b2 under hn afterwards. */
+static void compare_estimates(home__refine_solver *s, const double *hn, const double *hn0,
+                              const unsigned char *excluded, double *e0, double *e1,
+                              double *zncc0, double *zncc1)
+{
+    const home__refine_state *st = s->st;
+    const int fl = s->finest;
+    const home__refine_points *tp = &s->tpl[fl];
+    const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
+    double sigma0;
+    float m[9];
+    home__refine_level_matrix(s, hn, fl, m);
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s->img_b2);
+    home__refine_level_matrix(s, hn0, fl, m);
+    st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s->img_b);
+    if (excluded) {
+        int i;
+        for (i = 0; i < tp->n; i++)
+            if (is_excluded(s, tp, i, fl)) s->img_b[i] = s->img_b2[i] = -1.0f;
+    }
+    s->alpha = 1.0;
+    s->beta = 0.0;
+    home__refine_fit_photometric(s, tp, s->img_b, s->img_b2, SIGMA_FLOOR * 1e3, s->res, s->wt);
+    sigma0 = home__refine_robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta,
+                                       (int32_t *)(void *)s->wt);
+    *e0 = photometric_error(s, s->img_b, s->img_b2, sigma0, zncc0);
+    *e1 = photometric_error(s, s->img_b2, s->img_b, sigma0, zncc1);
+}
+
 /* A probe's leash: the refinement gives up as soon as its estimate lies within radius of back
  * (it came back: no optimum of its own) or radius or more from h0 (it went elsewhere), or a
  * level ends without converging. */
@@ -586,7 +617,7 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
-    double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, sigma0, refined_std;
+    double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, refined_std;
     double noise_std = -1.0;
     int level, it, converged = 0, iterations = 0;
     const double max_std =
@@ -659,29 +690,8 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
         return 0.0;
     }
     /* like for like: both estimates over the points both keep, at the scale of HOME's */
-    {
-        const int fl = s.finest;
-        const home__refine_points *tp = &s.tpl[fl];
-        const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
-        float m[9];
-        home__refine_level_matrix(&s, s.hn, fl, m);
-        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
-        home__refine_level_matrix(&s, hn0, fl, m);
-        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
-        if (excluded) {
-            int i;
-            for (i = 0; i < tp->n; i++)
-                if (is_excluded(&s, tp, i, fl)) s.img_b[i] = s.img_b2[i] = -1.0f;
-        }
-        s.alpha = 1.0;
-        s.beta = 0.0;
-        home__refine_fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
-        sigma0 = home__refine_robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta,
-                                           (int32_t *)(void *)s.wt);
-        e0 = photometric_error(&s, s.img_b, s.img_b2, sigma0, &zncc0);
-        e1 = photometric_error(&s, s.img_b2, s.img_b, sigma0, &zncc1);
-        result->refine_inlier_share = inlier_share(&s, s.img_b2, s.img_b);
-    }
+    compare_estimates(&s, s.hn, hn0, excluded, &e0, &e1, &zncc0, &zncc1);
+    result->refine_inlier_share = inlier_share(&s, s.img_b2, s.img_b);
     result->refine_error[0] = e0;
     result->refine_error[1] = e1;
     result->refine_zncc = zncc1;
@@ -799,7 +809,7 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
-    double h1[9], step = INFINITY, e0, e1, zncc, sigma0;
+    double hn0[9], h1[9], step = INFINITY, e0, e1, zncc0, zncc1;
     int level, it, converged = 0;
     home__refine_solver_setup(ctx, slot, &s);
     home__refine_to_normalised(&s, home__refine_identity, s.hn);
@@ -834,24 +844,10 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
     remove_noise_information(&s);
     *sigma_px = REFINE_SIGMA_SCALE * corner_std_px(&s);
     if (!(*sigma_px <= DETERMINED_STD_PX * 2.0)) return 0;
-    {
-        /* the estimate explains frame B better than the identity does */
-        const home__refine_points *tp = &s.tpl[s.finest];
-        const int n4 = (tp->n + LANES - 1) & ~(LANES - 1), fl = s.finest;
-        float m[9];
-        home__refine_level_matrix(&s, s.hn, fl, m);
-        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b2);
-        home__refine_level_matrix(&s, home__refine_identity, fl, m);
-        st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s.img_b);
-        s.alpha = 1.0;
-        s.beta = 0.0;
-        home__refine_fit_photometric(&s, tp, s.img_b, s.img_b2, SIGMA_FLOOR * 1e3, s.res, s.wt);
-        sigma0 = home__refine_robust_sigma(s.img_b, tp->t, tp->n, s.alpha, s.beta,
-                                           (int32_t *)(void *)s.wt);
-        e0 = photometric_error(&s, s.img_b, s.img_b2, sigma0, &zncc);
-        e1 = photometric_error(&s, s.img_b2, s.img_b, sigma0, &zncc);
-        if (!(e1 < e0)) return 0;
-    }
+    /* the estimate explains frame B better than the identity does */
+    home__refine_to_normalised(&s, home__refine_identity, hn0);
+    compare_estimates(&s, s.hn, hn0, NULL, &e0, &e1, &zncc0, &zncc1);
+    if (!(e1 < e0)) return 0;
     memcpy(h, h1, sizeof h1);
     return 1;
 }
