@@ -83,8 +83,8 @@ int home_default_config(home_config *cfg, int width, int height)
     cfg->max_model = HOME_MODEL_HOMOGRAPHY;
     cfg->max_sigma_px = 1.0f;
     /* a fast pass on the 4x4-box copy where that leaves the Hough image 160 px wide or more:
-     * a seventh of the time per pair (make bench, 640x360 and 1280x720), at the same errors and
-     * silent errors and with fewer failures on every set of the evaluation (docs/speed.md) */
+     * a fraction of the time per pair, at the same errors and silent errors and with fewer
+     * failures on every set of the evaluation (docs/speed.md) */
     cfg->fast_pass_downscale = width >= 640 && height >= 4 * HOME_MIN_SIDE ? 4 : 0;
     if (width < HOME_MIN_SIDE || height < HOME_MIN_SIDE || width > HOME_MAX_SIDE ||
         height > HOME_MAX_SIDE)

@@ -350,8 +350,9 @@ double home__hough_stream(home_context *ctx, const uint8_t *image, ptrdiff_t str
 
 /* The Hough stage's block of the arena: offsets from its start, each on a HOME__BLOCK_ALIGN
  * boundary. EXACT: the gradients; FAST: the image and its transpose, the theta rows' geometry
- * (every row's when it fits HOME_HOUGH_GEOMETRY_BYTES, else one scratch record), line sums,
- * border prefix sums and J over the intercepts. Both: one theta row's sums, the smoothing rings. */
+ * (every row's when it fits HOME_HOUGH_GEOMETRY_BYTES, else one scratch record) and the
+ * first_row table its computation uses, line sums, border prefix sums and J over the
+ * intercepts. Both: one theta row's sums, the smoothing rings. */
 typedef struct hough_layout {
     size_t grad_x, grad_y, img_n, img_t, img_end, geom, geom_scratch, first_row, line_sum,
         edge_prefix, line_j;

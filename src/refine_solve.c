@@ -608,6 +608,34 @@ static int off_leash(const home__refine_solver *s, const double *h0, const probe
            !(home__refine_max_corner_distance(s->cx, s->cy, h, h0) < leash->radius);
 }
 
+/* Gauss-Newton steps at `level`, at most max_iterations, counted in *iterations: 1 when
+ * converged (a step below STEP_EPS_PX, or at the finest level far below the estimate's own
+ * predicted error: noisy frames, low light, keep the steps jittering at that scale), -1 when a
+ * step fails (too few usable points, singular), else 0 (out of steps, or off a probe's leash). */
+static int run_level(home__refine_solver *s, int level, int max_iterations, const double *h0,
+                     const probe_leash *leash, int *iterations)
+{
+    double step, last_step = INFINITY, noise_std = -1.0;
+    int it;
+    for (it = 0; it < max_iterations; it++) {
+        ++*iterations;
+        if (!iterate(s, level, &step)) return -1;
+        if (step < STEP_EPS_PX * (double)(1 << level)) return 1;
+        if (level == s->finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
+            if (!(noise_std >= 0.0)) { /* predicted once, near the optimum */
+                s->resid_var = residual_variance(s);
+                noise_std = corner_std_px(s);
+            }
+            if (step < STEP_NOISE_SHARE * noise_std) return 1;
+        }
+        /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
+        if (step > 0.5 * last_step) s->hessian_level = -1;
+        last_step = step;
+        if (leash && off_leash(s, h0, leash)) break;
+    }
+    return 0;
+}
+
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
  * without the points of the excluded regions (NULL: none), on a probe's leash (NULL: none).
  * Writes the refined H and fills the refine fields of result. */
@@ -617,9 +645,8 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
-    double hn0[9], h1[9], e0, e1, zncc0, zncc1, step = INFINITY, refined_std;
-    double noise_std = -1.0;
-    int level, it, converged = 0, iterations = 0;
+    double hn0[9], h1[9], e0, e1, zncc0, zncc1, refined_std;
+    int level, converged = 0, iterations = 0;
     const double max_std =
         MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
 
@@ -641,29 +668,11 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
         }
     }
     for (level = st->levels - 1; level >= s.finest; level--) {
-        double last_step = INFINITY;
-        converged = 0;
-        for (it = 0; it < ctx->cfg.refine_iterations; it++) {
-            iterations++;
-            if (!iterate(&s, level, &step)) {
-                result->refine_iterations = iterations;
-                result->refine_status = HOME_REFINE_FEW_POINTS;
-                return 0.0;
-            }
-            if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
-            /* at the finest level, also a step far below the estimate's own predicted
-             * uncertainty: noisy frames (low light) keep the steps jittering at that scale */
-            if (level == s.finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
-                if (!(noise_std >= 0.0)) { /* predicted once, near the optimum */
-                    s.resid_var = residual_variance(&s);
-                    noise_std = corner_std_px(&s);
-                }
-                if (step < STEP_NOISE_SHARE * noise_std) { converged = 1; break; }
-            }
-            /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
-            if (step > 0.5 * last_step) s.hessian_level = -1;
-            last_step = step;
-            if (leash && off_leash(&s, h0, leash)) break;
+        converged = run_level(&s, level, ctx->cfg.refine_iterations, h0, leash, &iterations);
+        if (converged < 0) {
+            result->refine_iterations = iterations;
+            result->refine_status = HOME_REFINE_FEW_POINTS;
+            return 0.0;
         }
         if (leash && !converged) break;
     }
@@ -809,33 +818,19 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
-    double hn0[9], h1[9], step = INFINITY, e0, e1, zncc0, zncc1;
-    int level, it, converged = 0;
+    double hn0[9], h1[9], e0, e1, zncc0, zncc1;
+    int level, converged = 0, iterations = 0;
     home__refine_solver_setup(ctx, slot, &s);
     home__refine_to_normalised(&s, home__refine_identity, s.hn);
     for (level = s.finest; level < st->levels; level++)
         if (s.tpl[level].n < MIN_POINTS) return 0;
     for (level = st->levels - 1; level >= s.finest; level--) {
-        double noise_std = -1.0, last_step = INFINITY;
         if (!determined_subspace(&s, level)) return 0;
         s.hessian_level = -1;
-        converged = 0;
         /* a horizon in fog is blurred: its steps shrink slowly (up to four times the
          * refinement's iterations per level) */
-        for (it = 0; it < 4 * ctx->cfg.refine_iterations; it++) {
-            if (!iterate(&s, level, &step)) return 0;
-            if (step < STEP_EPS_PX * (double)(1 << level)) { converged = 1; break; }
-            /* as refine_run(): at the finest level, steps far below the predicted error */
-            if (level == s.finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
-                if (!(noise_std >= 0.0)) {
-                    s.resid_var = residual_variance(&s);
-                    noise_std = corner_std_px(&s);
-                }
-                if (step < STEP_NOISE_SHARE * noise_std) { converged = 1; break; }
-            }
-            if (step > 0.5 * last_step) s.hessian_level = -1; /* as refine_run(): fresh */
-            last_step = step;
-        }
+        converged = run_level(&s, level, 4 * ctx->cfg.refine_iterations, NULL, NULL, &iterations);
+        if (converged < 0) return 0;
     }
     if (!converged) return 0;
     to_pixels(&s, s.hn, h1);
