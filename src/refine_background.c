@@ -29,6 +29,9 @@
                                one) */
 #define MAD_WINDOW (2 * MAD_RADIUS + 16)   /* at least the 512 grey levels of r's median */
 #define MIN_SHARE 48        /* fewer than 1/MIN_SHARE of the pixels: no test */
+#define SCREEN_STEP 4       /* the screening pass: every fourth row, */
+#define SCREEN_EVIDENCE 5.0 /* ... the motion's expected score and evidence there this large, */
+#define SCREEN_SHARE 0.667  /* ... and this share of it observed: the background moves */
 
 /* The background of A and B in sixteenths smoothed by the 5-tap binomial (sigma 1 px) in both
  * directions, edges replicated. Rows, then columns in place with the interior apart from the
@@ -136,23 +139,24 @@ static void find_background(const uint16_t *a, const uint16_t *b, int w, int h, 
     }
 }
 
-/* Bilinear sample (sixteenths) of a w x h image at (u, v) into out; 0 outside [0, w-1] x
- * [0, h-1]. */
-static int sample16(const uint16_t *img, int w, int h, double u, double v, double *out)
+/* Bilinear sample (sixteenths) of a w x h image at (u, v), which row_span() keeps inside [0, w-1]
+ * x [0, h-1] up to rounding (the clamps hold the reads inside the image). */
+static double sample16(const uint16_t *img, int w, int h, double u, double v)
 {
-    int x0, y0;
+    int x0 = (int)u, y0 = (int)v;
     double fx, fy;
     const uint16_t *p;
-    if (!(u >= 0.0 && v >= 0.0 && u <= w - 1 && v <= h - 1)) return 0;
-    x0 = (int)u;
-    y0 = (int)v;
     if (x0 > w - 2) x0 = w - 2;
     if (y0 > h - 2) y0 = h - 2;
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
     fx = u - x0;
     fy = v - y0;
     p = img + (ptrdiff_t)y0 * w + x0;
-    *out = (1.0 - fy) * ((1.0 - fx) * p[0] + fx * p[1]) + fy * ((1.0 - fx) * p[w] + fx * p[w + 1]);
-    return 1;
+    {
+        const double top = p[0] + fx * (p[1] - p[0]), bottom = p[w] + fx * (p[w + 1] - p[w]);
+        return top + fy * (bottom - top);
+    }
 }
 
 /* The inverse of the 3x3 matrix m into inv; 0 when singular. */
@@ -168,14 +172,34 @@ static int invert3(const double *m, double *inv)
     return 1;
 }
 
-/* (u, v) = m (x, y), 0 behind the camera. */
-static int apply(const double *m, double x, double y, double *u, double *v)
+/* The columns [*lo, *hi] of row y whose image under m lies in front of the camera and inside
+ * [0, w-1] x [0, h-1]: u and v are monotonic along a row where the denominator keeps its sign,
+ * so each bound is a linear inequality in x (a x + b >= 0). Empty when *lo > *hi. */
+static void row_span(const double *m, int w, int h, int y, int *lo, int *hi)
 {
-    const double den = m[6] * x + m[7] * y + m[8];
-    if (!(den > 1e-9)) return 0;
-    *u = (m[0] * x + m[1] * y + m[2]) / den;
-    *v = (m[3] * x + m[4] * y + m[5]) / den;
-    return 1;
+    const double num_u = m[1] * y + m[2], num_v = m[4] * y + m[5], den = m[7] * y + m[8];
+    /* a x + b >= 0 for: den > 0, u >= 0, u <= w - 1, v >= 0, v <= h - 1 */
+    const double a[5] = {m[6], m[0], (w - 1) * m[6] - m[0], m[3], (h - 1) * m[6] - m[3]};
+    const double b[5] = {den - 1e-9, num_u, (w - 1) * den - num_u, num_v, (h - 1) * den - num_v};
+    double l = *lo, r = *hi;
+    int i;
+    for (i = 0; i < 5; i++) {
+        if (a[i] > 0.0) {
+            const double t = ceil(-b[i] / a[i]);
+            if (t > l) l = t;
+        } else if (a[i] < 0.0) {
+            const double t = floor(-b[i] / a[i]);
+            if (t < r) r = t;
+        } else if (!(b[i] >= 0.0)) {
+            l = r + 1.0;
+        }
+    }
+    if (!(l <= r)) { /* NaN included */
+        *hi = *lo - 1;
+        return;
+    }
+    *lo = (int)l;
+    *hi = (int)r;
 }
 
 /* Sums over the background pixels for inner products with [1, A] projected out. */
@@ -216,18 +240,23 @@ static long prepare(const home__refine_state *st, const uint16_t *a, const uint1
      * histogram of r = B - A there (sixteenths, within +-4095) by grey levels: for its median,
      * the grey level, then the sixteenth */
     memset(hist, 0, sizeof hist);
-    for (y = BORDER; y < hh - BORDER; y++)
-        for (x = next_set(mask + (ptrdiff_t)y * w, BORDER, w - BORDER); x < w - BORDER;
-             x = next_set(mask + (ptrdiff_t)y * w, x + 1, w - BORDER)) {
+    for (y = BORDER; y < hh - BORDER; y++) {
+        uint8_t *row = mask + (ptrdiff_t)y * w;
+        int lo = BORDER, hi = w - BORDER - 1;
+        row_span(m, w, hh, y, &lo, &hi);
+        row_span(m_inv, w, hh, y, &lo, &hi);
+        if (lo > hi) {
+            memset(row, 0, (size_t)w);
+            continue;
+        }
+        memset(row, 0, (size_t)lo);
+        memset(row + hi + 1, 0, (size_t)(w - hi - 1));
+        for (x = next_set(row, lo, hi + 1); x <= hi; x = next_set(row, x + 1, hi + 1)) {
             const ptrdiff_t p = (ptrdiff_t)y * w + x;
-            double u, v;
-            mask[p] = apply(m, x, y, &u, &v) && u >= 0.0 && v >= 0.0 && u <= w - 1 &&
-                      v <= hh - 1 && apply(m_inv, x, y, &u, &v) && u >= 0.0 && v >= 0.0 &&
-                      u <= w - 1 && v <= hh - 1;
-            if (!mask[p]) continue;
             n++;
             hist[((int)b[p] - (int)a[p] + 4096) >> 4]++;
         }
+    }
     if (n * MIN_SHARE < (long)w * hh) return 0;
     half = (int)(n / 2);
     for (j = 0, cum = 0; j < 511 && cum + hist[j] <= half; j++) cum += hist[j];
@@ -252,6 +281,104 @@ static long prepare(const home__refine_state *st, const uint16_t *a, const uint1
     return n;
 }
 
+/* The sums over the background rows first, first + step, ... (mask from prepare(); sa, sb:
+ * both frames smoothed; r outside [lo, hi] left out) added into k. */
+static void accumulate(const home__refine_state *st, const uint16_t *a, const uint16_t *b,
+                       const int16_t *sa, const int16_t *sb, const double *m,
+                       const double *m_inv, double lo, double hi, int first, int step,
+                       score_sums *k)
+{
+    const int w = st->background_w, hh = st->background_h;
+    const uint8_t *mask = st->flat;
+    int x, y, j;
+    for (y = first; y < hh - BORDER; y += step) {
+        /* both maps along the row: numerators and denominators linear in x */
+        const double nub = m[1] * y + m[2], nvb = m[4] * y + m[5], db = m[7] * y + m[8];
+        const double nua = m_inv[1] * y + m_inv[2], nva = m_inv[4] * y + m_inv[5];
+        const double da = m_inv[7] * y + m_inv[8];
+        for (x = next_set(mask + (ptrdiff_t)y * w, BORDER, w - BORDER); x < w - BORDER;
+             x = next_set(mask + (ptrdiff_t)y * w, x + 1, w - BORDER)) {
+            const ptrdiff_t p = (ptrdiff_t)y * w + x;
+            double dx, dy, v[N_V], av, ua, va, ub, vb, inv;
+            v[V_R] = (int)b[p] - (int)a[p];
+            if (v[V_R] < lo || v[V_R] > hi) continue;
+            inv = 1.0 / (m[6] * x + db);
+            ub = (m[0] * x + nub) * inv;
+            vb = (m[3] * x + nvb) * inv;
+            inv = 1.0 / (m_inv[6] * x + da);
+            ua = (m_inv[0] * x + nua) * inv;
+            va = (m_inv[3] * x + nva) * inv;
+            dx = ub - x;
+            dy = vb - y;
+            /* the prediction p = -grad . d from A and from B smoothed (central differences) */
+            v[V_PA] = -0.5 * ((sa[p + 1] - sa[p - 1]) * dx + (sa[p + w] - sa[p - w]) * dy);
+            v[V_PB] = -0.5 * ((sb[p + 1] - sb[p - 1]) * dx + (sb[p + w] - sb[p - w]) * dy);
+            /* what r would be under h, from A alone (A at h^-1(x) - A(x)) and from B alone
+             * (B(x) - B at h(x)): exact where the background's detail is finer than d */
+            v[V_QA] = sample16(a, w, hh, ua, va) - a[p];
+            v[V_QB] = b[p] - sample16(b, w, hh, ub, vb);
+            v[V_P] = 0.5 * (v[V_PA] + v[V_PB]);
+            v[V_GX] = 0.25 * ((sa[p + 1] - sa[p - 1]) + (sb[p + 1] - sb[p - 1]));
+            v[V_GY] = 0.25 * ((sa[p + w] - sa[p - w]) + (sb[p + w] - sb[p - w]));
+            av = a[p];
+            k->n += 1.0;
+            k->a += av;
+            k->aa += av * av;
+            for (j = 0; j < N_V; j++) {
+                k->s[j] += v[j];
+                k->sa[j] += v[j] * av;
+            }
+            k->rr += v[V_R] * v[V_R];
+            k->rp += v[V_R] * v[V_P];
+            k->pp += v[V_P] * v[V_P];
+            k->qapb += v[V_QA] * v[V_PB];
+            k->qbpa += v[V_QB] * v[V_PA];
+            k->xx += v[V_GX] * v[V_GX];
+            k->xy += v[V_GX] * v[V_GY];
+            k->yy += v[V_GY] * v[V_GY];
+            k->rx += v[V_R] * v[V_GX];
+            k->ry += v[V_R] * v[V_GY];
+            k->dd += dx * dx + dy * dy;
+            {
+                const double t = 0.5 * (v[V_QA] * v[V_PB] + v[V_QB] * v[V_PA]);
+                k->e += t;
+                k->ee += t * t;
+            }
+        }
+    }
+}
+
+/* k into the test's statistics (home__refine_background_score's); 0 when they are undefined */
+static int finish(const score_sums *k, double *observed, double *expected, double *evidence,
+                  double *own_motion)
+{
+    double e_raw, spread, sigma2, norm, rp, pp, rr;
+    rp = projected(k, k->rp, V_R, V_P);
+    pp = projected(k, k->pp, V_P, V_P);
+    rr = projected(k, k->rr, V_R, V_R);
+    if (!(pp > 0.0) || !(k->n > 3.0)) return 0;
+    /* the noise: what r keeps after the constant, A and p */
+    sigma2 = (rr - rp * rp / pp) / (k->n - 3.0);
+    if (!(sigma2 > 0.0)) return 0;
+    norm = sqrt(sigma2 * pp);
+    *observed = rp / norm;
+    e_raw = 0.5 * (projected(k, k->qapb, V_QA, V_PB) + projected(k, k->qbpa, V_QB, V_PA));
+    *expected = e_raw / norm;
+    spread = k->ee - k->e * k->e / k->n;
+    *evidence = spread > 0.0 ? e_raw / sqrt(spread) : 0.0;
+    /* the background's own translation g: least squares of r = -grad . g, against h's RMS
+     * displacement there */
+    *own_motion = 0.0;
+    {
+        const double xx = projected(k, k->xx, V_GX, V_GX), xy = projected(k, k->xy, V_GX, V_GY);
+        const double yy = projected(k, k->yy, V_GY, V_GY), rx = projected(k, k->rx, V_R, V_GX);
+        const double ry = projected(k, k->ry, V_R, V_GY), det = xx * yy - xy * xy;
+        if (det > 0.0 && k->dd > 0.0)
+            *own_motion = hypot(yy * rx - xy * ry, xx * ry - xy * rx) / det / sqrt(k->dd / k->n);
+    }
+    return 1;
+}
+
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
                                   const double *h, double *observed, double *expected,
                                   double *evidence, double *own_motion)
@@ -259,9 +386,8 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
     const home__refine_state *st = &ctx->refine;
     const int w = st->background_w, hh = st->background_h;
     int16_t *sa = st->sampled, *sb = st->smoothed_b;
-    uint8_t *mask = st->flat;
-    int x, y, j;
-    double m[9], m_inv[9], e_raw, spread, median, mad, sigma2, norm, rp, pp, rr, lo, hi;
+    int first;
+    double m[9], m_inv[9], median, mad, lo, hi;
     score_sums k;
     *observed = *expected = *evidence = *own_motion = 0.0;
     if (!prepare(st, a, b, h, m, m_inv, &median, &mad)) return 0;
@@ -270,76 +396,17 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
     smooth(a, w, hh, sa);
     smooth(b, w, hh, sb);
     memset(&k, 0, sizeof k);
-    for (y = BORDER; y < hh - BORDER; y++)
-        for (x = next_set(mask + (ptrdiff_t)y * w, BORDER, w - BORDER); x < w - BORDER;
-             x = next_set(mask + (ptrdiff_t)y * w, x + 1, w - BORDER)) {
-            const ptrdiff_t p = (ptrdiff_t)y * w + x;
-            double dx, dy, v[N_V], av, ua, va, ub, vb, pred_a, pred_b;
-            v[V_R] = (int)b[p] - (int)a[p];
-            if (v[V_R] < lo || v[V_R] > hi) continue;
-            apply(m, x, y, &ub, &vb);
-            apply(m_inv, x, y, &ua, &va);
-            dx = ub - x;
-            dy = vb - y;
-            /* the prediction p = -grad . d from A and from B smoothed (central differences) */
-            v[V_PA] = -0.5 * ((sa[p + 1] - sa[p - 1]) * dx + (sa[p + w] - sa[p - w]) * dy);
-            v[V_PB] = -0.5 * ((sb[p + 1] - sb[p - 1]) * dx + (sb[p + w] - sb[p - w]) * dy);
-            /* what r would be under h, from A alone (A at h^-1(x) - A(x)) and from B alone
-             * (B(x) - B at h(x)): exact where the background's detail is finer than d */
-            sample16(a, w, hh, ua, va, &pred_a);
-            sample16(b, w, hh, ub, vb, &pred_b);
-            v[V_QA] = pred_a - a[p];
-            v[V_QB] = b[p] - pred_b;
-            v[V_P] = 0.5 * (v[V_PA] + v[V_PB]);
-            v[V_GX] = 0.25 * ((sa[p + 1] - sa[p - 1]) + (sb[p + 1] - sb[p - 1]));
-            v[V_GY] = 0.25 * ((sa[p + w] - sa[p - w]) + (sb[p + w] - sb[p - w]));
-            av = a[p];
-            k.n += 1.0;
-            k.a += av;
-            k.aa += av * av;
-            for (j = 0; j < N_V; j++) {
-                k.s[j] += v[j];
-                k.sa[j] += v[j] * av;
-            }
-            k.rr += v[V_R] * v[V_R];
-            k.rp += v[V_R] * v[V_P];
-            k.pp += v[V_P] * v[V_P];
-            k.qapb += v[V_QA] * v[V_PB];
-            k.qbpa += v[V_QB] * v[V_PA];
-            k.xx += v[V_GX] * v[V_GX];
-            k.xy += v[V_GX] * v[V_GY];
-            k.yy += v[V_GY] * v[V_GY];
-            k.rx += v[V_R] * v[V_GX];
-            k.ry += v[V_R] * v[V_GY];
-            k.dd += dx * dx + dy * dy;
-            {
-                const double t = 0.5 * (v[V_QA] * v[V_PB] + v[V_QB] * v[V_PA]);
-                k.e += t;
-                k.ee += t * t;
-            }
-        }
+    /* every SCREEN_STEP-th row first: a background that already shows most of the motion
+     * there, on evidence of its own, moves (the full test could only agree but by chance) */
+    accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, BORDER, SCREEN_STEP, &k);
+    if (k.n * MIN_SHARE * SCREEN_STEP >= (double)w * hh &&
+        finish(&k, observed, expected, evidence, own_motion) &&
+        *expected >= SCREEN_EVIDENCE && *evidence >= SCREEN_EVIDENCE &&
+        *observed >= SCREEN_SHARE * *expected)
+        return 1;
+    for (first = BORDER + 1; first < BORDER + SCREEN_STEP; first++)
+        accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, first, SCREEN_STEP, &k);
+    *observed = *expected = *evidence = *own_motion = 0.0;
     if (k.n * MIN_SHARE < (double)w * hh) return 0;
-    rp = projected(&k, k.rp, V_R, V_P);
-    pp = projected(&k, k.pp, V_P, V_P);
-    rr = projected(&k, k.rr, V_R, V_R);
-    if (!(pp > 0.0)) return 0;
-    /* the noise: what r keeps after the constant, A and p */
-    sigma2 = (rr - rp * rp / pp) / (k.n - 3.0);
-    if (!(sigma2 > 0.0)) return 0;
-    norm = sqrt(sigma2 * pp);
-    *observed = rp / norm;
-    e_raw = 0.5 * (projected(&k, k.qapb, V_QA, V_PB) + projected(&k, k.qbpa, V_QB, V_PA));
-    *expected = e_raw / norm;
-    spread = k.ee - k.e * k.e / k.n;
-    *evidence = spread > 0.0 ? e_raw / sqrt(spread) : 0.0;
-    /* the background's own translation g: least squares of r = -grad . g, against h's RMS
-     * displacement there */
-    {
-        const double xx = projected(&k, k.xx, V_GX, V_GX), xy = projected(&k, k.xy, V_GX, V_GY);
-        const double yy = projected(&k, k.yy, V_GY, V_GY), rx = projected(&k, k.rx, V_R, V_GX);
-        const double ry = projected(&k, k.ry, V_R, V_GY), det = xx * yy - xy * xy;
-        if (det > 0.0 && k.dd > 0.0)
-            *own_motion = hypot(yy * rx - xy * ry, xx * ry - xy * rx) / det / sqrt(k.dd / k.n);
-    }
-    return 1;
+    return finish(&k, observed, expected, evidence, own_motion);
 }
