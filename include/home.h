@@ -101,7 +101,9 @@ typedef struct home_config {
                                  hough_downscale > 1, see the failure rule at home_match) */
     /* photometric refinement of HOME's H (home_refine() below); refine_levels = 0 turns it off */
     int refine_levels;        /* pyramid levels, 1..HOME_REFINE_MAX_LEVELS; default 3 */
-    int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 */
+    int refine_iterations;    /* Gauss-Newton iteration cap per level; default 10 (from a
+                                 start HOME's lines determine, the finest level may go on to
+                                 4x while its steps keep shrinking slowly: noisy frames) */
     float refine_trust_px;    /* corner motion from HOME's H the refinement may always make,
                                  in px of the Hough image (x hough_downscale in the image);
                                  beyond it, and beyond 3x HOME's predicted error, the two
@@ -233,7 +235,7 @@ enum home_refine_status {
     HOME_REFINE_NO_SNAPSHOT,      /* a is not in the context's last two extracted frames, or b
                                      is not the last one (see home_match) */
     HOME_REFINE_FEW_POINTS,       /* too little texture: fewer than 64 usable template points */
-    HOME_REFINE_NOT_CONVERGED,    /* the finest level used hit refine_iterations */
+    HOME_REFINE_NOT_CONVERGED,    /* the finest level used hit its iteration cap */
     HOME_REFINE_ILL_CONDITIONED,  /* corner standard deviation above max(0.5 px, max_sigma_px)
                                      (predicted, or from two interleaved halves of the points),
                                      no model determined, or the refined H fails

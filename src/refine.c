@@ -75,14 +75,14 @@ static double corner_distance(const home_context *ctx, const double *h1, const d
  * frame leaves the motion undetermined (a few edges, most through one point), the optimum it
  * stops at depends on where it starts, and a large move away from HOME's estimate is then no
  * evidence. */
-static int same_optimum(home_context *ctx, int slot, const double *start,
+static int same_optimum(home_context *ctx, int slot, const double *start, int patient,
                         const home_result *refined)
 {
     home_result check = *refined;
     double mid[9], tolerance = 3.0 * refined->sigma_px;
     int k;
     for (k = 0; k < 9; k++) mid[k] = 0.5 * (start[k] + refined->H[k]);
-    home__refine_run(ctx, slot, mid, &check);
+    home__refine_run(ctx, slot, mid, patient, &check);
     if (tolerance < SAME_OPTIMUM_FLOOR_PX) tolerance = SAME_OPTIMUM_FLOOR_PX;
     return check.refined && corner_distance(ctx, check.H, refined->H) <= tolerance;
 }
@@ -129,7 +129,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
 {
     home__refine_state *st = &ctx->refine;
     home_result trial;
-    int slot, vouches, agrees, has_estimate;
+    int slot, vouches, agrees, has_estimate, patient;
     double t0 = home__now(ctx), radius, d, share, clear_share, apart;
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
@@ -145,7 +145,10 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     trial = *result;
     /* without an estimate of HOME's, direct alignment from the identity (small motion: dim,
      * faint or textureless frames give too few lines but may hold enough gradient) */
-    apart = home__refine_run(ctx, slot, has_estimate ? result->H : home__refine_identity, &trial);
+    /* a start HOME's lines determine (ok, or only too uncertain) is worth more iterations */
+    patient = result->ok || result->failure == HOME_FAIL_UNCERTAIN;
+    apart = home__refine_run(ctx, slot, has_estimate ? result->H : home__refine_identity, patient,
+                             &trial);
     if (!has_estimate) {
         /* a local method vouches only within its reach: the identity is a start whose
          * uncertainty is the trust floor */
@@ -185,7 +188,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             trial.refine_zncc = 0.0;
         } else if (agrees ? result->ok || vouches
                           : vouches && trial.refine_inlier_share >= VOUCH_SHARE &&
-                                same_optimum(ctx, slot, result->H, &trial)) {
+                                same_optimum(ctx, slot, result->H, patient, &trial)) {
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
         } else {

@@ -46,6 +46,8 @@ typedef struct home__refine_solver {
                                            take no part where nonzero (NULL: every point
                                            does) */
     int mask_level;                     /* the level img_b2 holds the points' mask for */
+    double signal_share;                /* the share of the finest J^T W J that is the
+                                           frames' information, where its slow steps tell */
 } home__refine_solver;
 
 extern const double home__refine_identity[9];
@@ -101,11 +103,14 @@ int home__refine_fit_photometric(home__refine_solver *s, const home__refine_poin
 double home__refine_max_corner_distance(double cx, double cy, const double *h1,
                                         const double *h2);
 /* Refine h0 (A -> B pixels) with the template of slot `slot` against the stored pyramid:
- * the refined H and the refine fields of result. */
+ * the refined H and the refine fields of result. patient (a start HOME vouches for): the
+ * finest level may go on past the iteration cap while its steps keep shrinking (noisy
+ * templates approach the optimum slowly). */
 /* Returns, when it converged but the optimum is too uncertain to use (ILL_CONDITIONED), how far
  * the optimum lies from h0 in units of both estimates' predicted errors (result->sigma_px on
  * entry is h0's); else 0. */
-double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result);
+double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
+                        home_result *result);
 /* The same without the points of the regions excluded flags (the identity test's grid): the
  * motion of the rest of the frame. */
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,

@@ -22,6 +22,9 @@
                                   solved when its standard deviation (without the noise's
                                   apparent information) is at most this, full-size px at the
                                   finest level (twice per coarser level) */
+#define SLOW_ITERATIONS 4    /* a finest level still shrinking its steps may take this many
+                                times the iteration cap */
+#define SIGNAL_SHARE_MIN 0.05 /* ... the information kept then, at least this share */
 #define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
                                   (calibrated on the evaluation's tuning set: neighbouring
                                   template points do not carry independent noise) */
@@ -552,6 +555,7 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
     s->alpha = 1.0;
     s->hessian_level = -1;
     s->mask_level = -1;
+    s->signal_share = 1.0;
     s->k = 8;
     for (s->finest = st->finest_level; s->finest < st->levels - 1; s->finest++) {
         const int cap_half = s->tpl[s->finest].capacity / 2;
@@ -608,28 +612,46 @@ static int off_leash(const home__refine_solver *s, const double *h0, const probe
            !(home__refine_max_corner_distance(s->cx, s->cy, h, h0) < leash->radius);
 }
 
-/* Gauss-Newton steps at `level`, at most max_iterations, counted in *iterations: 1 when
+/* Gauss-Newton steps at `level`, at most max_iterations (at the finest level up to
+ * slow_iterations while the steps keep shrinking), counted in *iterations: 1 when
  * converged (a step below STEP_EPS_PX, or at the finest level far below the estimate's own
  * predicted error: noisy frames, low light, keep the steps jittering at that scale), -1 when a
  * step fails (too few usable points, singular), else 0 (out of steps, or off a probe's leash). */
-static int run_level(home__refine_solver *s, int level, int max_iterations, const double *h0,
-                     const probe_leash *leash, int *iterations)
+static int run_level(home__refine_solver *s, int level, int max_iterations, int slow_iterations,
+                     const double *h0, const probe_leash *leash, int *iterations)
 {
-    double step, last_step = INFINITY, noise_std = -1.0;
-    int it;
-    for (it = 0; it < max_iterations; it++) {
+    double step, last_step = INFINITY, noise_std = -1.0, cap_step = 0.0;
+    int it, shrinking = 0, converged = 0;
+    for (it = 0; it < slow_iterations || it < max_iterations; it++) {
+        /* past the cap, the finest level goes on (up to slow_iterations) only while every step
+         * is shorter than the last, though not by half: template gradients that are mostly
+         * noise (low light) shorten each Gauss-Newton step by about the same share, and the
+         * optimum is still approached, slowly */
+        if (it >= max_iterations && !(level == s->finest && shrinking)) break;
         ++*iterations;
         if (!iterate(s, level, &step)) return -1;
-        if (step < STEP_EPS_PX * (double)(1 << level)) return 1;
-        if (level == s->finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
+        if (step < STEP_EPS_PX * (double)(1 << level)) converged = 1;
+        if (!converged && level == s->finest && step < NOISE_CHECK_PX * (double)(1 << level)) {
             if (!(noise_std >= 0.0)) { /* predicted once, near the optimum */
                 s->resid_var = residual_variance(s);
                 noise_std = corner_std_px(s);
             }
-            if (step < STEP_NOISE_SHARE * noise_std) return 1;
+            converged = step < STEP_NOISE_SHARE * noise_std;
         }
+        if (converged) {
+            /* past the cap, each step was rho times the last: J^T W J held 1 / (1 - rho) times
+             * the information the frames give (the rest is the template's noise) */
+            if (it >= max_iterations && cap_step > 0.0) {
+                const double rho = pow(step / cap_step, 1.0 / (it - max_iterations + 1));
+                s->signal_share = rho < 1.0 - SIGNAL_SHARE_MIN ? 1.0 - rho : SIGNAL_SHARE_MIN;
+            }
+            return 1;
+        }
+        if (it == max_iterations - 1) cap_step = step;
         /* the reused J^T W J no longer fits the weights (steps not even halving): fresh */
         if (step > 0.5 * last_step) s->hessian_level = -1;
+        /* slowly: shorter than the last step, but not by half */
+        shrinking = step < last_step && step >= 0.5 * last_step;
         last_step = step;
         if (leash && off_leash(s, h0, leash)) break;
     }
@@ -640,13 +662,13 @@ static int run_level(home__refine_solver *s, int level, int max_iterations, cons
  * without the points of the excluded regions (NULL: none), on a probe's leash (NULL: none).
  * Writes the refined H and fills the refine fields of result. */
 static double refine_run(home_context *ctx, int slot, const double *h0,
-                         const unsigned char *excluded, const probe_leash *leash,
+                         const unsigned char *excluded, const probe_leash *leash, int patient,
                          home_result *result)
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
     double hn0[9], h1[9], e0, e1, zncc0, zncc1, refined_std;
-    int level, converged = 0, iterations = 0;
+    int level, k, converged = 0, iterations = 0;
     const double max_std =
         MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
 
@@ -668,7 +690,9 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
         }
     }
     for (level = st->levels - 1; level >= s.finest; level--) {
-        converged = run_level(&s, level, ctx->cfg.refine_iterations, h0, leash, &iterations);
+        converged = run_level(&s, level, ctx->cfg.refine_iterations,
+                              patient ? SLOW_ITERATIONS * ctx->cfg.refine_iterations : 0, h0,
+                              leash, &iterations);
         if (converged < 0) {
             result->refine_iterations = iterations;
             result->refine_status = HOME_REFINE_FEW_POINTS;
@@ -681,6 +705,8 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
     to_pixels(&s, s.hn, h1);
     s.resid_var = residual_variance(&s);
     remove_noise_information(&s);
+    if (s.signal_share < 1.0)
+        for (k = 0; k < 64; k++) s.jtj[k] *= s.signal_share;
     refined_std = corner_std_px(&s);
     if (refined_std > max_std || !(s.split_px <= max_std)) {
         /* how far the optimum lies from the start, in both estimates' predicted errors (the
@@ -829,7 +855,8 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
         s.hessian_level = -1;
         /* a horizon in fog is blurred: its steps shrink slowly (up to four times the
          * refinement's iterations per level) */
-        converged = run_level(&s, level, 4 * ctx->cfg.refine_iterations, NULL, NULL, &iterations);
+        converged = run_level(&s, level, 4 * ctx->cfg.refine_iterations, 0, NULL, NULL,
+                              &iterations);
         if (converged < 0) return 0;
     }
     if (!converged) return 0;
@@ -847,15 +874,16 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
     return 1;
 }
 
-double home__refine_run(home_context *ctx, int slot, const double *h0, home_result *result)
+double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
+                        home_result *result)
 {
-    return refine_run(ctx, slot, h0, NULL, NULL, result);
+    return refine_run(ctx, slot, h0, NULL, NULL, patient, result);
 }
 
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,
                                 const unsigned char *excluded, home_result *result)
 {
-    return refine_run(ctx, slot, h0, excluded, NULL, result);
+    return refine_run(ctx, slot, h0, excluded, NULL, 0, result);
 }
 
 void home__refine_probe(home_context *ctx, int slot, const double *h0, const double *back,
@@ -864,5 +892,5 @@ void home__refine_probe(home_context *ctx, int slot, const double *h0, const dou
     probe_leash leash;
     leash.back = back;
     leash.radius = radius;
-    refine_run(ctx, slot, h0, NULL, &leash, result);
+    refine_run(ctx, slot, h0, NULL, &leash, 0, result);
 }
