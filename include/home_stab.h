@@ -122,7 +122,8 @@ enum home_stab_motion_status {
     HOME_STAB_MOTION_IMPLAUSIBLE, /* H outside the configured limits: held (no motion) */
     HOME_STAB_MOTION_CUT,       /* a scene cut (or home_stab_cut()): the path restarts here */
     HOME_STAB_MOTION_STILL,     /* a small motion among frames registered as the identity (a
-                                   still camera): taken as none */
+                                   still camera), or one the plain background of the frames
+                                   around refutes (objects over fog): taken as none */
     HOME_STAB_MOTION_RESTORED,  /* a motion HOME refused because the frame's plain background
                                    stood still, taken because the frames around it register a
                                    moving camera (a plain part moving with the camera: a hand at

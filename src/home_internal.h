@@ -86,6 +86,9 @@ typedef struct home__refine_state {
     int16_t *sampled;                 /* ... and frame B there under the motion tested (the
                                          score test: frame A smoothed) */
     int16_t *smoothed_b;              /* the score test: frame B smoothed */
+    int scored;                       /* the last home__refine_apply() ran the score test on
+                                         its answer: */
+    double score[3];                  /* ... observed, expected, evidence */
     const home__refine_kernels *rk;   /* SIMD backend, as cfg.simd */
     void *scratch;
 } home__refine_state;
@@ -353,5 +356,11 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
  * refine_solve.c, home__refine_determined): 1 with h and its predicted error (full-size px). */
 int home__refine_determined_motion(home_context *ctx, uint32_t id_a, uint32_t id_b, double *h,
                                    double *sigma_px);
+/* The still-background score test of the last home__refine_apply()'s motion (src/
+ * refine_background.c: observed, expected, evidence), where it ran: 1, else 0. A frame's test
+ * can be too weak to refute the motion (a plain background in fog); several frames' together
+ * may not be (the stabiliser's). */
+int home__refine_last_score(const home_context *ctx, double *observed, double *expected,
+                            double *evidence);
 
 #endif

@@ -124,6 +124,29 @@ int home__refine_determined_motion(home_context *ctx, uint32_t id_a, uint32_t id
     return home__refine_determined(ctx, slot, h, sigma_px);
 }
 
+int home__refine_last_score(const home_context *ctx, double *observed, double *expected,
+                            double *evidence)
+{
+    const home__refine_state *st = &ctx->refine;
+    if (!st->scored) return 0;
+    *observed = st->score[0];
+    *expected = st->score[1];
+    *evidence = st->score[2];
+    return 1;
+}
+
+/* Does the background refute h (the score test; kept for home__refine_last_score())? */
+static int background_refutes(home_context *ctx, int slot, const double *h, double *own_motion)
+{
+    home__refine_state *st = &ctx->refine;
+    double *sc = st->score;
+    st->scored = home__refine_background_score(ctx, st->background16[slot],
+                                               st->background16[st->next_slot ^ 1], h, &sc[0],
+                                               &sc[1], &sc[2], own_motion);
+    return st->scored && sc[1] >= BACKGROUND_EVIDENCE && sc[2] >= BACKGROUND_EVIDENCE &&
+           sc[0] < sc[1] / 3.0;
+}
+
 /* Failure rule with the refinement (documented in home.h at home_match). */
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
 {
@@ -133,6 +156,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     double t0 = home__now(ctx), radius, d, share, clear_share, apart;
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
+    st->scored = 0;
     if (!st->levels) return;
     slot = find_slot(st, id_a);
     if (slot < 0 || st->pyr_id != id_b || !id_b) {
@@ -215,7 +239,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             isfinite(trial.sigma_px) && d_identity <= IDENTITY_SIGMAS * trial.sigma_px;
         int against = 0;
         unsigned char still_regions[REGIONS_X * REGIONS_Y] = {0};
-        double observed, expected, evidence, own_motion;
+        double own_motion;
         share = clear_share = 0.0;
         if (!within_sigma)
             share = home__refine_identity_share(ctx, slot, trial.H, &clear_share, &against,
@@ -240,12 +264,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
              * HOME's lines 1-1.5 px off, the optimum 4-8 px away): neither can be vouched for */
             trial.ok = 0;
             trial.failure = HOME_FAIL_INCONSISTENT;
-        } else if (home__refine_background_score(ctx, st->background16[slot],
-                                                 st->background16[st->next_slot ^ 1], trial.H,
-                                                 &observed, &expected, &evidence,
-                                                 &own_motion) &&
-                   expected >= BACKGROUND_EVIDENCE && evidence >= BACKGROUND_EVIDENCE &&
-                   observed < expected / 3.0) {
+        } else if (background_refutes(ctx, slot, trial.H, &own_motion)) {
             /* ... or the background would show the motion clearly, and shows far less of it
              * than predicted: the moving objects' motion over a still background */
             trial.ok = 0;

@@ -39,6 +39,9 @@ typedef struct stab_slot {
     int has_candidate;            /* held, refused only because the plain background stood still: */
     home_stab_sim candidate;      /* the refused motion, plausible, */
     double candidate_weight;      /* and the weight it would have */
+    int has_score;                /* its motion, registered ok, had the still-background score
+                                     test: */
+    double score[3];              /* ... observed, expected, evidence (home__refine_last_score) */
     int smoothed_ready;           /* its segment has ended: `smoothed` is its final path */
     home_stab_sim smoothed;
 } stab_slot;

@@ -8,7 +8,11 @@
  * stood still is either a moving object over a still background (a tripod shot: its neighbours
  * register the identity) or the camera's motion with a plain part moving along (a hand at the
  * lens, blocks an encoder left unchanged: its neighbours register motions). Among moving
- * neighbours and no still one it is taken, instead of holding the frame and keeping its shake. */
+ * neighbours and no still one it is taken, instead of holding the frame and keeping its shake.
+ * A still background refutes what one frame cannot: where the background is plain (fog), one
+ * pair's score test is too weak to refuse the objects' motion HOME registers, but the tests of
+ * the frames around, summed, can be strong enough; a motion they refute, and its own test leans
+ * against, becomes none. */
 #include "stab_internal.h"
 #include <math.h>
 
@@ -20,6 +24,10 @@
  * however lone (a knocked tripod, 7 px at 640x360). Not a multiple of sigma_px: the lone wrong
  * motions of a textured object over a faint background are 10-30 of their own sigma off. */
 #define STILL_KNOCK 0.02
+#define BACKGROUND_BEFORE 30   /* the score tests summed: frames before the motion (as far as
+                                  the ring holds them; and up to STILL_AFTER after it), */
+#define BACKGROUND_EVIDENCE 5.0 /* ... their expected score and evidence at least this (the
+                                   single frame's bounds, refine.c) */
 #define RESTORE_BEFORE 8       /* frames looked at before a refused motion (and up to STILL_AFTER
                                   after it), */
 #define RESTORE_MIN 2          /* registered moving (ok, not the identity), with none still */
@@ -88,11 +96,53 @@ static void retake_motion(home_stab *st, long t, long newest, const home_stab_si
     }
 }
 
-/* Decide frame t's motion once the frames up to newest are in: a lone one becomes none. */
+/* A frame's score test on a plain background: the motion's expected score rests on many
+ * pixels, its per-pixel terms spread no wider than the noise (expected / evidence at most 1; a
+ * fog: about 0.6). Where a few pixels next to texture carry it (2.5-3.5 on a structured scene
+ * whose camera moves), observed falls short of expected for right motions too. */
+static int plain_score(const stab_slot *s)
+{
+    return s->has_score && s->score[1] > 0.0 && s->score[2] >= s->score[1];
+}
+
+/* Does the plain background, over the frames around t, refute t's motion? Each ok motion's
+ * score test (refine_background.c) gives observed, about N(0, 1) when the background stands
+ * still, against expected, what the background would show if it moved so; where it is plain
+ * (fog) one frame's expected is too small to tell. The frames' tests are independent
+ * measurements of the same question, so their sums are tested as one: the sum of observed is
+ * N(0, n) under a still background. */
+static int background_refutes(const home_stab *st, long t, long newest)
+{
+    const stab_slot *s = slot_of(st, t);
+    const long after = newest - t < STILL_AFTER ? newest - t : STILL_AFTER;
+    double observed = 0.0, expected = 0.0, spread = 0.0;
+    long i;
+    int n = 0;
+    /* its own test leans the same way (a camera that starts moving after a still stretch
+     * shows its motion in its own frames) */
+    if (s->status != HOME_STAB_MOTION_OK || s->registered_still || !plain_score(s) ||
+        !(s->score[0] < s->score[1] / 3.0))
+        return 0;
+    for (i = t - BACKGROUND_BEFORE; i <= t + after; i++)
+        if (i > st->first && slot_of(st, i)->frame == i && plain_score(slot_of(st, i))) {
+            const double *sc = slot_of(st, i)->score;
+            observed += sc[0];
+            expected += sc[1];
+            spread += (sc[1] / sc[2]) * (sc[1] / sc[2]); /* expected's own spread */
+            n++;
+        }
+    return n > 1 && expected >= BACKGROUND_EVIDENCE * sqrt((double)n) &&
+           expected >= BACKGROUND_EVIDENCE * sqrt(spread) && observed < expected / 3.0;
+}
+
+/* Decide frame t's motion once the frames up to newest are in: a lone one, or one the
+ * background around refutes, becomes none. */
 void home__stab_settle_still(home_stab *st, long t, long newest)
 {
     static const home_stab_sim none = {0, 0, 0, 0};
-    if (t <= st->first || t < st->emitted || !is_lone(st, t, newest)) return;
+    if (t <= st->first || t < st->emitted ||
+        !(is_lone(st, t, newest) || background_refutes(st, t, newest)))
+        return;
     retake_motion(st, t, newest, &none, HOME_STAB_MOTION_STILL, slot_of(st, t)->weight);
 }
 

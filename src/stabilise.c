@@ -435,8 +435,8 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     ptrdiff_t stride;
     home_features *swap;
     home_stab_sim motion = {0, 0, 0, 0}, candidate = {0, 0, 0, 0};
-    double weight = 1.0, candidate_weight = 1.0;
-    int has_candidate = 0;
+    double weight = 1.0, candidate_weight = 1.0, score[3] = {0.0, 0.0, 0.0};
+    int has_candidate = 0, has_score = 0;
     stab_slot *slot;
     double t0 = 0, z[4];
     long n;
@@ -460,6 +460,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
             out->newest_status = HOME_STAB_MOTION_IMPLAUSIBLE;
             if (plausible_motion(st, &out->reg, &motion, &weight))
                 out->newest_status = HOME_STAB_MOTION_OK;
+            has_score = home__refine_last_score(st->home, &score[0], &score[1], &score[2]);
         } else if (out->reg.refine_status == HOME_REFINE_STILL_BACKGROUND) {
             has_candidate = plausible_motion(st, &out->reg, &candidate, &candidate_weight);
         } else if (partial_motion(st, &out->reg, &motion, &weight)) {
@@ -481,6 +482,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
         weight = 1.0;   /* as a stream's first frame */
         memset(&motion, 0, sizeof motion);
         has_candidate = 0;
+        has_score = 0;
     }
     st->cut_requested = 0;
     if (st->cfg.clock) out->ms_register = st->cfg.clock(st->cfg.clock_user) - t0;
@@ -495,6 +497,8 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     slot->has_candidate = has_candidate;
     slot->candidate = candidate;
     slot->candidate_weight = candidate_weight;
+    slot->has_score = has_score;
+    memcpy(slot->score, score, sizeof score);
     slot->smoothed_ready = 0;
     if (n == st->first) {
         memset(&slot->raw, 0, sizeof slot->raw);
