@@ -359,7 +359,7 @@ int home__refine_determined_motion(home_context *ctx, uint32_t id_a, uint32_t id
 /* The still-background score test of the last home__refine_apply()'s motion (src/
  * refine_background.c: observed, expected, evidence), where it ran: 1, else 0. A frame's test
  * can be too weak to refute the motion (a plain background in fog); several frames' together
- * may not be (the stabiliser's). */
+ * can be strong enough (the stabiliser sums them). */
 int home__refine_last_score(const home_context *ctx, double *observed, double *expected,
                             double *evidence);
 

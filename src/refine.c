@@ -167,10 +167,10 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     has_estimate = result->ok || ((result->failure == HOME_FAIL_FEW_INLIERS ||
                                    result->failure == HOME_FAIL_UNCERTAIN) && result->inliers >= 8);
     trial = *result;
-    /* without an estimate of HOME's, direct alignment from the identity (small motion: dim,
-     * faint or textureless frames give too few lines but may hold enough gradient) */
     /* a start HOME's lines determine (ok, or only too uncertain) is worth more iterations */
     patient = result->ok || result->failure == HOME_FAIL_UNCERTAIN;
+    /* without an estimate of HOME's, direct alignment from the identity (small motion: dim,
+     * faint or textureless frames give too few lines but may hold enough gradient) */
     apart = home__refine_run(ctx, slot, has_estimate ? result->H : home__refine_identity, patient,
                              &trial);
     if (!has_estimate) {

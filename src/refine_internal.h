@@ -155,8 +155,10 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
  * motion; evidence: expected over the spread of its per-pixel terms; own_motion: the
  * translation the background shows by itself (least squares on its gradient) over h's RMS
  * displacement there (about 0 if it stands still, below 1 if a part of it moves with h, large
- * if it moves otherwise). Returns 0 (all 0) when there is too little background or no
- * refinement. Uses the match-time scratch. */
+ * if it moves otherwise). Every fourth row is tested first: where the background there
+ * already shows the motion (observed at least two thirds of expected, both expected and
+ * evidence at least 5), those rows' statistics are returned. Returns 0 (all 0) when there is
+ * too little background or no refinement. Uses the match-time scratch. */
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
                                   const double *h, double *observed, double *expected,
                                   double *evidence, double *own_motion);
