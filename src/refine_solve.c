@@ -92,7 +92,7 @@ void home__refine_level_matrix(const home__refine_solver *s, const double *hn, i
     const double q[9] = {sc / s->f, 0, (o - s->cx) / s->f, 0, sc / s->f, (o - s->cy) / s->f, 0,
                          0,         1};
     const double p[9] = {s->f / sc, 0, (s->cx - o) / sc, 0, s->f / sc, (s->cy - o) / sc, 0, 0, 1};
-    double t[9], r[9];
+    double t[9] = {0}, r[9]; /* t: gcc -fanalyzer loses it through mat3_mul's loops */
     int k;
     mat3_mul(hn, q, t);
     mat3_mul(p, t, r);
