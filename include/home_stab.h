@@ -99,7 +99,8 @@ typedef struct home_stab_config {
                                  docs/presets.md) */
     int hough_downscale;      /* HOME's Hough transform on the registration image (1) or on its
                                  2x2- or 4x4-box downscaled copy (2, 4), see home_config; 0 =
-                                 automatic (home_video_config's: a copy about 160 px wide) */
+                                 automatic (4 where that copy is at least 96 px wide, else
+                                 home_video_config's: 2 from 320 px wide) */
     int theta_bins;           /* HOME's theta bins; 0 = automatic (88, fewer than
                                  home_video_config's 120: the refinement gives the precision);
                                  fewer suit tiny frames */
@@ -157,9 +158,9 @@ typedef struct home_stab home_stab;
 
 /* Defaults for a width x height stream: margins 0.10, automatic smoothing, lookahead 0, ease 0.6,
  * downscale 2 for frames wider than 960 px (else 1), then home_video_config()'s choices for the
- * registration image (500 keypoints per sign, automatic hough_downscale: Hough on a copy about
- * 160 px wide) with 88 theta bins, a theta window from max_rotation, refinement on with 1024
- * points, ending at half size. */
+ * registration image (500 keypoints per sign; automatic hough_downscale: the 4x4-box copy where
+ * that is at least 96 px wide, else home_video_config's) with 88 theta bins, a theta window from
+ * max_rotation, refinement on with 1024 points, ending at half size. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

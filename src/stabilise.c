@@ -14,6 +14,10 @@
 #define STAB_BISECT_STEPS 30
 #define STAB_THETA_BINS 88                /* HOME's automatic theta bins for video registration */
 #define STAB_REFINE_POINTS 1024           /* HOME's refinement template points at full size */
+/* automatic hough_downscale: the 4x4-box copy down to this width (home_video_config's stops at
+ * 160 px): the same jitter on the real-world set's 384x288 clips at 2/3 of the time (at 91 px,
+ * 364 px wide, one clip's was worse: bench/stab/README.md) */
+#define STAB_HOUGH_MIN_WIDTH 96
 /* A registration's predicted error (sigma_px, full-size px) weighs its motion: the measurement
  * noise of its frame is r (1 + (sigma / STAB_SIGMA_REF_PX)^2), so a coarse or uncertain motion
  * pulls the path less; beyond STAB_MAX_SIGMA_PX the frame holds the path. */
@@ -64,7 +68,8 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
     cfg->refine = 1;
     /* the refinement ends at half size: as smooth as the full-size ending, and cheaper */
     cfg->refine_finest_level = 1;
-    cfg->hough_downscale = 0;   /* automatic: home_video_config's, a copy ~160 px wide */
+    cfg->hough_downscale = 0;   /* automatic: the 4x4-box copy down to 96 px wide, else
+                                   home_video_config's */
     {
         home_config h;
         home_video_config(&h, HOME_MIN_SIDE, HOME_MIN_SIDE);
@@ -96,7 +101,10 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
     /* coarse estimates come back with their (larger) sigma, weighed by the smoother */
     h->max_sigma_px = (float)(STAB_MAX_SIGMA_PX / f);
     h->refine_finest_level = cfg->refine ? cfg->refine_finest_level : 0;
-    if (cfg->hough_downscale) h->hough_downscale = cfg->hough_downscale;
+    if (cfg->hough_downscale)
+        h->hough_downscale = cfg->hough_downscale;
+    else if (cfg->width / f >= 4 * STAB_HOUGH_MIN_WIDTH && cfg->height / f >= 4 * HOME_MIN_SIDE)
+        h->hough_downscale = 4;
     h->simd = cfg->simd;
     /* 88 instead of the video defaults' 120 theta bins: the refinement gives the precision, and
      * 88 is the fewest that keep enough inliers under strong shake (docs/presets.md) */
