@@ -139,8 +139,8 @@ static void find_background(const uint16_t *a, const uint16_t *b, int w, int h, 
     }
 }
 
-/* Bilinear sample (sixteenths) of a w x h image at (u, v), which row_span() keeps inside [0, w-1]
- * x [0, h-1] up to rounding (the clamps hold the reads inside the image). */
+/* Bilinear sample (sixteenths) of a w x h image at (u, v), within half a pixel of [0, w-1] x
+ * [0, h-1] (the clamps hold the reads inside the image). */
 static double sample16(const uint16_t *img, int w, int h, double u, double v)
 {
     int x0 = (int)u, y0 = (int)v;
@@ -182,7 +182,7 @@ static void row_span(const double *m, int w, int h, int y, int *lo, int *hi)
     const double a[5] = {m[6], m[0], (w - 1) * m[6] - m[0], m[3], (h - 1) * m[6] - m[3]};
     const double b[5] = {den - 1e-9, num_u, (w - 1) * den - num_u, num_v, (h - 1) * den - num_v};
     double l = *lo, r = *hi;
-    int i;
+    int i, empty = 0;
     for (i = 0; i < 5; i++) {
         if (a[i] > 0.0) {
             const double t = ceil(-b[i] / a[i]);
@@ -191,10 +191,11 @@ static void row_span(const double *m, int w, int h, int y, int *lo, int *hi)
             const double t = floor(-b[i] / a[i]);
             if (t < r) r = t;
         } else if (!(b[i] >= 0.0)) {
-            l = r + 1.0;
+            empty = 1;
         }
     }
-    if (!(l <= r)) { /* NaN included */
+    /* l and r stay within the span given, or cross it (NaN: empty too) */
+    if (empty || !(l <= r)) {
         *hi = *lo - 1;
         return;
     }
@@ -308,6 +309,11 @@ static void accumulate(const home__refine_state *st, const uint16_t *a, const ui
             inv = 1.0 / (m_inv[6] * x + da);
             ua = (m_inv[0] * x + nua) * inv;
             va = (m_inv[3] * x + nva) * inv;
+            /* the span's inequalities in floating point: far off only for extreme matrices
+             * (fuzz_api), whose rounding the division does not share */
+            if (!(ua > -0.5 && ua < w - 0.5 && va > -0.5 && va < hh - 0.5 && ub > -0.5 &&
+                  ub < w - 0.5 && vb > -0.5 && vb < hh - 0.5))
+                continue;
             dx = ub - x;
             dy = vb - y;
             /* the prediction p = -grad . d from A and from B smoothed (central differences) */
