@@ -362,5 +362,8 @@ int home__refine_determined_motion(home_context *ctx, uint32_t id_a, uint32_t id
  * can be strong enough (the stabiliser sums them). */
 int home__refine_last_score(const home_context *ctx, double *observed, double *expected,
                             double *evidence);
+/* The score test's verdict (src/refine.c): the background would show the motion clearly
+ * (expected and evidence, both z scores, large enough) and shows far less of it (observed). */
+int home__refine_score_refutes(double observed, double expected, double evidence);
 
 #endif

@@ -135,6 +135,12 @@ int home__refine_last_score(const home_context *ctx, double *observed, double *e
     return 1;
 }
 
+int home__refine_score_refutes(double observed, double expected, double evidence)
+{
+    return expected >= BACKGROUND_EVIDENCE && evidence >= BACKGROUND_EVIDENCE &&
+           observed < expected / 3.0;
+}
+
 /* Does the background refute h (the score test; kept for home__refine_last_score())? */
 static int background_refutes(home_context *ctx, int slot, const double *h, double *own_motion)
 {
@@ -143,8 +149,7 @@ static int background_refutes(home_context *ctx, int slot, const double *h, doub
     st->scored = home__refine_background_score(ctx, st->background16[slot],
                                                st->background16[st->next_slot ^ 1], h, &sc[0],
                                                &sc[1], &sc[2], own_motion);
-    return st->scored && sc[1] >= BACKGROUND_EVIDENCE && sc[2] >= BACKGROUND_EVIDENCE &&
-           sc[0] < sc[1] / 3.0;
+    return st->scored && home__refine_score_refutes(sc[0], sc[1], sc[2]);
 }
 
 /* Failure rule with the refinement (documented in home.h at home_match). */

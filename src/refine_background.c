@@ -148,8 +148,6 @@ static double sample16(const uint16_t *img, int w, int h, double u, double v)
     const uint16_t *p;
     if (x0 > w - 2) x0 = w - 2;
     if (y0 > h - 2) y0 = h - 2;
-    if (x0 < 0) x0 = 0;
-    if (y0 < 0) y0 = 0;
     fx = u - x0;
     fy = v - y0;
     p = img + (ptrdiff_t)y0 * w + x0;

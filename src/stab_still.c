@@ -14,6 +14,7 @@
  * the frames around, summed, can be strong enough; a motion they refute, and its own test leans
  * against, becomes none. */
 #include "stab_internal.h"
+#include "home_internal.h"
 #include <math.h>
 
 #define STILL_NEIGHBOURS 4     /* frames looked at around a motion, */
@@ -25,9 +26,7 @@
  * motions of a textured object over a faint background are 10-30 of their own sigma off. */
 #define STILL_KNOCK 0.02
 #define BACKGROUND_BEFORE 30   /* the score tests summed: frames before the motion (as far as
-                                  the ring holds them; and up to STILL_AFTER after it), */
-#define BACKGROUND_EVIDENCE 5.0 /* ... their expected score and evidence at least this (the
-                                   single frame's bounds, refine.c) */
+                                  the ring holds them; and up to STILL_AFTER after it) */
 #define RESTORE_BEFORE 8       /* frames looked at before a refused motion (and up to STILL_AFTER
                                   after it), */
 #define RESTORE_MIN 2          /* registered moving (ok, not the identity), with none still */
@@ -131,8 +130,10 @@ static int background_refutes(const home_stab *st, long t, long newest)
             spread += (sc[1] / sc[2]) * (sc[1] / sc[2]); /* expected's own spread */
             n++;
         }
-    return n > 1 && expected >= BACKGROUND_EVIDENCE * sqrt((double)n) &&
-           expected >= BACKGROUND_EVIDENCE * sqrt(spread) && observed < expected / 3.0;
+    /* the sums as one test's z scores, judged by the single frame's rule */
+    return n > 1 && home__refine_score_refutes(observed / sqrt((double)n),
+                                               expected / sqrt((double)n),
+                                               expected / sqrt(spread));
 }
 
 /* Decide frame t's motion once the frames up to newest are in: a lone one, or one the
