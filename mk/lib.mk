@@ -22,7 +22,7 @@ $(BUILD)/obj/port/%_avx2.o: CFLAGS_LIB += $(AVX2_FLAGS)
 # The line fit (port/line_fit.h) works on four matches per step in separate lanes, element-wise
 # too; its sqrt vectorises only without errno (-fno-math-errno: same IEEE square roots).
 # (The bare-metal build, mk/baremetal.mk, gives the same files the same flags.)
-LIB_VECTORISE := src/hough.c $(wildcard src/refine*.c) src/describe.c src/pipeline.c
+LIB_VECTORISE := src/hough.c $(wildcard src/refine*.c) src/describe.c src/pipeline.c src/stab_cut.c
 LIB_VECTORISE_NOERRNO := src/homography.c $(wildcard port/line_fit_*.c)
 $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_VECTORISE)): CFLAGS_LIB += -ftree-vectorize
 $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_VECTORISE_NOERRNO)): CFLAGS_LIB += -ftree-vectorize -fno-math-errno

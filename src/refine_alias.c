@@ -74,8 +74,18 @@ static int profile_period(float *sum, const float *count, int bins, double spaci
     for (lag = min_lag - 1; lag <= max_lag + 1; lag++) {
         /* <v[x], v[x + lag]> over x + lag < bins, normalised by both parts' norms */
         const double saa = squares[bins - 1 - lag], sbb = total_sq - squares[lag - 1];
-        double sab = 0.0;
-        for (x = 0; x + lag < bins; x++) sab += v[x] * v[x + lag];
+        /* four interleaved partial sums: independent chains the compiler can keep in vector
+         * lanes (the same order on every target, so the same result) */
+        double part[4] = {0.0, 0.0, 0.0, 0.0}, sab;
+        const int n = bins - lag, n4 = n & ~3;
+        for (x = 0; x < n4; x += 4) {
+            part[0] += v[x] * v[x + lag];
+            part[1] += v[x + 1] * v[x + 1 + lag];
+            part[2] += v[x + 2] * v[x + 2 + lag];
+            part[3] += v[x + 3] * v[x + 3 + lag];
+        }
+        for (; x < n; x++) part[x & 3] += v[x] * v[x + lag];
+        sab = (part[0] + part[1]) + (part[2] + part[3]);
         r[0] = r[1];
         r[1] = r[2];
         r[2] = saa > 0.0 && sbb > 0.0 ? (float)(sab / sqrt(saa * sbb)) : 0.0f;

@@ -10,22 +10,42 @@
  * black or faded frame): it tells nothing about a cut. */
 #define FLAT_THUMB_STD 2.0
 
+/* Columns summed at once (a stack buffer: the frame's width in chunks of this many) */
+#define THUMB_CHUNK 256
+/* A band's column sums fit 16 bits: at most (HOME_MAX_SIDE / SIDE + 1) / 2 + 1 rows of 255 */
+typedef char home__thumb_column_fits[((HOME_MAX_SIDE / SIDE + 1) / 2 + 1) * 255 <= 65535 ? 1 : -1];
+
 /* Cell means over every second row and column (the cells are 8 px or more on any frame HOME
- * accepts; a quarter of the pixels tell the mean as well). */
+ * accepts; a quarter of the pixels tell the mean as well). Each band of cells first sums its
+ * sampled rows column by column (a contiguous loop the compiler vectorises), then every
+ * cell adds its sampled columns from those sums: the same integers as pixel by pixel. */
 void home__stab_thumbnail(const uint8_t *luma, ptrdiff_t stride, int w, int h, float *thumb)
 {
-    int cx, cy, x, y;
+    uint16_t column[THUMB_CHUNK];
+    uint32_t cell[SIDE];
+    int cx, cy, x, y, i;
     for (cy = 0; cy < SIDE; cy++) {
-        const int y0 = cy * h / SIDE, y1 = (cy + 1) * h / SIDE;
+        const int y0 = cy * h / SIDE, y1 = (cy + 1) * h / SIDE, rows = (y1 - y0 + 1) / 2;
+        int start;
+        for (cx = 0; cx < SIDE; cx++) cell[cx] = 0;
+        for (start = 0; start < w; start += THUMB_CHUNK) {
+            const int end = start + THUMB_CHUNK < w ? start + THUMB_CHUNK : w;
+            for (i = 0; i < end - start; i++) column[i] = 0;
+            for (y = y0; y < y1; y += 2) {
+                const uint8_t *row = luma + (ptrdiff_t)y * stride + start;
+                for (i = 0; i < end - start; i++) column[i] = (uint16_t)(column[i] + row[i]);
+            }
+            for (cx = 0; cx < SIDE; cx++) {
+                const int x0 = cx * w / SIDE, x1 = (cx + 1) * w / SIDE;
+                /* the cell's sampled columns x0, x0 + 2, ... within this chunk */
+                x = x0 >= start ? x0 : start + ((start - x0) & 1);
+                for (; x < x1 && x < end; x += 2) cell[cx] += column[x - start];
+            }
+        }
         for (cx = 0; cx < SIDE; cx++) {
             const int x0 = cx * w / SIDE, x1 = (cx + 1) * w / SIDE;
-            uint32_t sum = 0, count = 0;
-            for (y = y0; y < y1; y += 2) {
-                const uint8_t *row = luma + (ptrdiff_t)y * stride;
-                for (x = x0; x < x1; x += 2) sum += row[x];
-                count += (uint32_t)(x1 - x0 + 1) / 2;
-            }
-            thumb[cy * SIDE + cx] = count ? (float)sum / (float)count : 0.0f;
+            const uint32_t count = (uint32_t)rows * (uint32_t)((x1 - x0 + 1) / 2);
+            thumb[cy * SIDE + cx] = count ? (float)cell[cx] / (float)count : 0.0f;
         }
     }
 }
