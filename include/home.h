@@ -308,7 +308,8 @@ typedef struct home_result {
  * Failure rule with refinement: HOME's estimate (ok, or short of inliers or certainty with at
  * least 8 inliers) is refined. An accepted refinement within max(refine_trust_px, 3 sigma_px)
  * of HOME's H agrees with it: the result is the refined H, ok when HOME's was, or when the
- * photometric fit vouches for it (refine_zncc >= 0.9 and sigma_px <= 0.4 max_sigma_px).
+ * photometric fit vouches for it (sigma_px <= 0.4 max_sigma_px, and refine_zncc >= 0.9 or
+ * refine_inlier_share >= 0.9: camera noise holds the correlation of dim frames down).
  * Farther away the two disagree: the refined H is the result only when it vouches for the
  * whole frame (also refine_inlier_share >= 0.9) and a second refinement, started halfway
  * between the two, reaches it too (within 3 sigma_px, at least 0.5 px), else the pair fails

@@ -60,7 +60,8 @@
                                  answers (few edges) predicted 0.44-0.66 px, 95 % of the right
                                  ones less than 0.4 */
 #define VOUCH_SHARE 0.9      /* ... and, against HOME's estimate or with none, with this share
-                                of its points within 3 robust sigmas */
+                                of its points within 3 robust sigmas (beside HOME's estimate
+                                this share may stand in for the correlation) */
 #define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
                                      within 3 sigma_px or this */
 
@@ -157,7 +158,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
 {
     home__refine_state *st = &ctx->refine;
     home_result trial;
-    int slot, vouches, agrees, has_estimate, patient;
+    int slot, vouches, consistent, agrees, has_estimate, patient;
     double t0 = home__now(ctx), radius, d, share, clear_share, apart;
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
@@ -205,6 +206,10 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         agrees = d <= radius;
         vouches = trial.refine_zncc >= VOUCH_ZNCC &&
                   trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
+        /* beside HOME's estimate, nearly every point consistent vouches as the correlation
+         * does: camera noise (dim frames) holds the correlation down, not that share */
+        consistent = trial.refine_inlier_share >= VOUCH_SHARE &&
+                   trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
         /* overruling HOME takes the whole frame: nearly every point consistent */
         /* the wide radius only admits the refinement's move; a like-for-like choice by sigma
          * needs the two within 3 sigma of each other (else the refinement went elsewhere: to
@@ -215,7 +220,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             trial = *result;
             trial.refine_status = HOME_REFINE_LESS_PRECISE;
             trial.refine_zncc = 0.0;
-        } else if (agrees ? result->ok || vouches
+        } else if (agrees ? result->ok || vouches || consistent
                           : vouches && trial.refine_inlier_share >= VOUCH_SHARE &&
                                 same_optimum(ctx, slot, result->H, patient, &trial)) {
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;

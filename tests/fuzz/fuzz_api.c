@@ -156,7 +156,8 @@ static void check_result(const home_config *cfg, const home_result *res)
         FZ_CHECK(res->sigma_px >= 0.0 && res->sigma_px <= cfg->max_sigma_px);
         FZ_CHECK(res->model >= HOME_MODEL_IDENTITY && res->model <= cfg->max_model);
         if (res->inliers < cfg->min_inliers) /* the refinement's rescue (home.h's failure rule) */
-            FZ_CHECK(res->refined && res->refine_zncc >= 0.9);
+            FZ_CHECK(res->refined &&
+                     (res->refine_zncc >= 0.9 || res->refine_inlier_share >= 0.9));
     } else {
         FZ_CHECK(res->failure >= HOME_FAIL_FEW_MATCHES && res->failure <= HOME_FAIL_INCONSISTENT);
     }
