@@ -12,8 +12,13 @@
 
 /* Columns summed at once (a stack buffer: the frame's width in chunks of this many) */
 #define THUMB_CHUNK 256
-/* A band's column sums fit 16 bits: at most (HOME_MAX_SIDE / SIDE + 1) / 2 + 1 rows of 255 */
-typedef char home__thumb_column_fits[((HOME_MAX_SIDE / SIDE + 1) / 2 + 1) * 255 <= 65535 ? 1 : -1];
+/* A band's column sums: at most (HOME_MAX_SIDE / SIDE + 1) / 2 + 1 rows of 255, 16 bits
+ * (twice the lanes of 32) up to the default HOME_MAX_SIDE */
+#if ((HOME_MAX_SIDE / HOME__STAB_THUMB_SIDE + 1) / 2 + 1) * 255 <= 65535
+typedef uint16_t column_sum;
+#else
+typedef uint32_t column_sum;
+#endif
 
 /* Cell means over every second row and column (the cells are 8 px or more on any frame HOME
  * accepts; a quarter of the pixels tell the mean as well). Each band of cells first sums its
@@ -21,7 +26,7 @@ typedef char home__thumb_column_fits[((HOME_MAX_SIDE / SIDE + 1) / 2 + 1) * 255 
  * cell adds its sampled columns from those sums: the same integers as pixel by pixel. */
 void home__stab_thumbnail(const uint8_t *luma, ptrdiff_t stride, int w, int h, float *thumb)
 {
-    uint16_t column[THUMB_CHUNK];
+    column_sum column[THUMB_CHUNK];
     uint32_t cell[SIDE];
     int cx, cy, x, y, i;
     for (cy = 0; cy < SIDE; cy++) {
@@ -33,7 +38,7 @@ void home__stab_thumbnail(const uint8_t *luma, ptrdiff_t stride, int w, int h, f
             for (i = 0; i < end - start; i++) column[i] = 0;
             for (y = y0; y < y1; y += 2) {
                 const uint8_t *row = luma + (ptrdiff_t)y * stride + start;
-                for (i = 0; i < end - start; i++) column[i] = (uint16_t)(column[i] + row[i]);
+                for (i = 0; i < end - start; i++) column[i] = (column_sum)(column[i] + row[i]);
             }
             for (cx = 0; cx < SIDE; cx++) {
                 const int x0 = cx * w / SIDE, x1 = (cx + 1) * w / SIDE;
