@@ -209,7 +209,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         /* beside HOME's estimate, nearly every point consistent vouches as the correlation
          * does: camera noise (dim frames) holds the correlation down, not that share */
         consistent = trial.refine_inlier_share >= VOUCH_SHARE &&
-                   trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
+                     trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
         /* overruling HOME takes the whole frame: nearly every point consistent */
         /* the wide radius only admits the refinement's move; a like-for-like choice by sigma
          * needs the two within 3 sigma of each other (else the refinement went elsewhere: to
