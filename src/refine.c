@@ -59,9 +59,8 @@
                                  without HOME's confirmation, the tuning set's wrong refined
                                  answers (few edges) predicted 0.44-0.66 px, 95 % of the right
                                  ones less than 0.4 */
-#define VOUCH_SHARE 0.9      /* ... and, against HOME's estimate or with none, with this share
-                                of its points within 3 robust sigmas (beside HOME's estimate
-                                this share may stand in for the correlation) */
+#define VOUCH_SHARE 0.9      /* ... and this share of its points within 3 robust sigmas (both
+                                against HOME's estimate or with none; either beside it) */
 #define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
                                      within 3 sigma_px or this */
 
@@ -153,12 +152,24 @@ static int background_refutes(home_context *ctx, int slot, const double *h, doub
     return st->scored && home__refine_score_refutes(sc[0], sc[1], sc[2]);
 }
 
+/* Does a refined estimate vouch for itself? A predicted error within VOUCH_SIGMA_SHARE of
+ * max_sigma_px, and a correlation of VOUCH_ZNCC and VOUCH_SHARE of its points within 3 robust
+ * sigmas: both for the whole frame (against HOME's estimate, or without one); beside HOME's
+ * estimate either, since camera noise (dim frames) holds the correlation down, not that share. */
+static int vouches(const home_context *ctx, const home_result *r, int whole_frame)
+{
+    const int correlated = r->refine_zncc >= VOUCH_ZNCC;
+    const int consistent = r->refine_inlier_share >= VOUCH_SHARE;
+    return r->sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px &&
+           (whole_frame ? correlated && consistent : correlated || consistent);
+}
+
 /* Failure rule with the refinement (documented in home.h at home_match). */
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
 {
     home__refine_state *st = &ctx->refine;
     home_result trial;
-    int slot, vouches, consistent, agrees, has_estimate, patient;
+    int slot, agrees, has_estimate, patient;
     double t0 = home__now(ctx), radius, d, share, clear_share, apart;
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
@@ -182,9 +193,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     if (!has_estimate) {
         /* a local method vouches only within its reach: the identity is a start whose
          * uncertainty is the trust floor */
-        if (trial.refined && trial.refine_zncc >= VOUCH_ZNCC &&
-            trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px &&
-            trial.refine_inlier_share >= VOUCH_SHARE && trial.sigma_px <= ctx->cfg.max_sigma_px &&
+        if (trial.refined && vouches(ctx, &trial, 1) &&
             corner_distance(ctx, trial.H, home__refine_identity) <=
                 ctx->cfg.refine_trust_px * ctx->hough_scale) {
             trial.ok = 1;
@@ -204,13 +213,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             radius = 3.0 * result->sigma_px;
         d = corner_distance(ctx, trial.H, result->H);
         agrees = d <= radius;
-        vouches = trial.refine_zncc >= VOUCH_ZNCC &&
-                  trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
-        /* beside HOME's estimate, nearly every point consistent vouches as the correlation
-         * does: camera noise (dim frames) holds the correlation down, not that share */
-        consistent = trial.refine_inlier_share >= VOUCH_SHARE &&
-                     trial.sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
-        /* overruling HOME takes the whole frame: nearly every point consistent */
+        /* overruling HOME takes the whole frame */
         /* the wide radius only admits the refinement's move; a like-for-like choice by sigma
          * needs the two within 3 sigma of each other (else the refinement went elsewhere: to
          * moving objects the static test below can then refute, say) */
@@ -220,8 +223,8 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
             trial = *result;
             trial.refine_status = HOME_REFINE_LESS_PRECISE;
             trial.refine_zncc = 0.0;
-        } else if (agrees ? result->ok || vouches || consistent
-                          : vouches && trial.refine_inlier_share >= VOUCH_SHARE &&
+        } else if (agrees ? result->ok || vouches(ctx, &trial, 0)
+                          : vouches(ctx, &trial, 1) &&
                                 same_optimum(ctx, slot, result->H, patient, &trial)) {
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
