@@ -261,9 +261,13 @@ enum home_refine_status {
     HOME_REFINE_STILL_REGIONS,    /* a tenth of the regions that clearly decide prefer the
                                      identity: a part of the frame stands still while the
                                      motion moves the rest, not ok (HOME_FAIL_INCONSISTENT) */
-    HOME_REFINE_PERIODIC          /* a repeated pattern: the motion one period along it fits
+    HOME_REFINE_PERIODIC,         /* a repeated pattern: the motion one period along it fits
                                      about as well, so the pair cannot tell which is right;
                                      sigma_px at least the period, not ok (HOME_FAIL_UNCERTAIN) */
+    HOME_REFINE_DENSE             /* frames too faint for HOME and for the refinement's points
+                                     (slow shading, a soft shadow): aligned from the identity
+                                     with every pixel of their quarter-size images, a
+                                     translation or a similarity */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */
@@ -318,7 +322,12 @@ typedef struct home_result {
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the
  * identity is tried; it vouches like an overruling refinement and must stay within
- * refine_trust_px of the identity.
+ * refine_trust_px of the identity. Where that fails too (and nothing made the pair
+ * inconsistent), every pixel of the quarter-size frames is aligned from the identity, coarse to
+ * fine, in the most general model max_model allows (HOME_REFINE_DENSE: slow shading, a soft
+ * shadow): it vouches the same way, reaches a pixel of its coarsest image (16 px at 640x360),
+ * and the refinement's points, where they determine an optimum from it, must find it within
+ * 3 sigma_px.
  *
  * Static camera: an ok motion within 2 sigma_px of the identity, or one that most regions of an
  * 8x6 grid explain worse than the identity does (each region votes with its own strongest

@@ -54,6 +54,7 @@ const char *home_refine_status_name(int status)
     case HOME_REFINE_BACKGROUND_MOVES: return "background_moves";
     case HOME_REFINE_STILL_REGIONS: return "still_regions";
     case HOME_REFINE_PERIODIC: return "periodic";
+    case HOME_REFINE_DENSE: return "dense";
     default: return "unknown";
     }
 }

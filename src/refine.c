@@ -61,6 +61,9 @@
                                  ones less than 0.4 */
 #define VOUCH_SHARE 0.9      /* ... and this share of its points within 3 robust sigmas (both
                                 against HOME's estimate or with none; either beside it) */
+#define DENSE_SIGMA_SHARE 0.3 /* dense alignment vouches within this share of max_sigma_px:
+                                 the tuning set's wrong dense answers (a few edges over wide
+                                 shading) predicted 0.34-0.36 px */
 #define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
                                      within 3 sigma_px or this */
 
@@ -164,6 +167,20 @@ static int vouches(const home_context *ctx, const home_result *r, int whole_fram
            (whole_frame ? correlated && consistent : correlated || consistent);
 }
 
+/* Do the template points, where they determine an optimum from the dense estimate, find it
+ * there too (within 3 sigma_px of either)? A few edges over wide shaded areas: the shading
+ * pulls the dense fit off what the edges say. */
+static int points_agree(home_context *ctx, int slot, const home_result *dense)
+{
+    home_result check = *dense;
+    double tolerance;
+    check.refined = 0;
+    home__refine_run(ctx, slot, dense->H, 0, &check);
+    if (!check.refined) return 1;
+    tolerance = 3.0 * (check.sigma_px > dense->sigma_px ? check.sigma_px : dense->sigma_px);
+    return corner_distance(ctx, check.H, dense->H) <= tolerance;
+}
+
 /* Failure rule with the refinement (documented in home.h at home_match). */
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
 {
@@ -243,6 +260,23 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
          * tuning set nearly every such estimate was more than 2 px off */
         trial.ok = 0;
         trial.failure = HOME_FAIL_INCONSISTENT;
+    }
+    /* frames too faint for HOME's lines and for the refinement's points (no failure of
+     * consistency: nothing refutes another answer) may still hold a motion in the slow
+     * shading of all their pixels; it vouches like direct alignment without an estimate */
+    if (!trial.ok && !result->ok && trial.failure != HOME_FAIL_INCONSISTENT) {
+        home_result dense = *result;
+        const double reach = ctx->cfg.refine_trust_px * ctx->hough_scale;
+        double dense_reach;
+        if (home__refine_dense(ctx, slot, &dense, &dense_reach) && vouches(ctx, &dense, 1) &&
+            dense.sigma_px <= DENSE_SIGMA_SHARE * ctx->cfg.max_sigma_px &&
+            corner_distance(ctx, dense.H, home__refine_identity) <=
+                (dense_reach > reach ? dense_reach : reach) &&
+            points_agree(ctx, slot, &dense)) {
+            trial = dense;
+            trial.ok = 1;
+            trial.failure = HOME_FAIL_NONE;
+        }
     }
     /* a motion its own predicted error cannot tell from the identity is no evidence of one; a
      * motion the static background does not share is the moving objects' */

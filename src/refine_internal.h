@@ -16,6 +16,9 @@
                                  (faint texture: less noise there). With the stabiliser's small
                                  budget, a few edges never fill 512 at half size: ending a level
                                  coarser gave wrong optima 2-5 px off at sigma 0.6-0.9 */
+#define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
+                                  (calibrated on the evaluation's tuning set: neighbouring
+                                  template points do not carry independent noise) */
 #define REGIONS_X 8          /* the identity test's grid of regions (refine_static.c) */
 #define REGIONS_Y 6
 #define REGION_TOP 8         /* the identity test's points per region: the strongest blocks */
@@ -162,6 +165,15 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
                                   const double *h, double *observed, double *expected,
                                   double *evidence, double *own_motion);
+
+/* refine_dense.c: frames A (slot) and B aligned from the identity with every pixel of their
+ * background16 images and two 2x2 means of them: a similarity (a translation under
+ * cfg.max_model), coarse to fine. 1 with result's H, model, sigma_px, refine_zncc and
+ * refine_inlier_share (refine_status HOME_REFINE_DENSE) when it converged to a determined,
+ * plausible motion; else 0 (result's refine_status may say why). *reach_px: a pixel of its
+ * coarsest image, full-size px (how far from the identity it reaches). Uses st->sampled and
+ * st->smoothed_b. */
+int home__refine_dense(home_context *ctx, int slot, home_result *result, double *reach_px);
 
 /* refine_alias.c: 1 when the refinement, started from h shifted by one period of frame A's
  * repeated pattern either way (periods along a few directions, up to three of them tried),

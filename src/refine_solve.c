@@ -25,9 +25,6 @@
 #define SLOW_ITERATIONS 4    /* a finest level still shrinking its steps may take this many
                                 times the iteration cap */
 #define SIGNAL_SHARE_MIN 0.05 /* ... the information kept then, at least this share */
-#define REFINE_SIGMA_SCALE 1.5 /* predicted errors are the Fisher covariance's times this
-                                  (calibrated on the evaluation's tuning set: neighbouring
-                                  template points do not carry independent noise) */
 
 const double home__refine_identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 

@@ -1,0 +1,485 @@
+/* Dense direct alignment for frames too faint for template points: a few slow shading waves, a
+ * soft shadow, a gentle ridge. Their gradients stay under the noise floor of every pyramid
+ * level's point selection, yet summed over all pixels of a coarse image they can determine a
+ * translation or a similarity well (docs/trust.md, session 20).
+ *
+ * Method: inverse-compositional Gauss-Newton of the most general motion cfg.max_model allows
+ * (a homography by default: a similarity fitted to a perspective motion is wrong with a small
+ * predicted error) on the two slots' background16 images (quarter size, at most
+ * HOME__BACKGROUND_PIXELS, in sixteenths of a grey level) and two 2x2 means of them, coarse to
+ * fine from the identity, every interior pixel a template point; a gain and bias and Cauchy
+ * weights as in the refinement. The predicted error comes from J^T W J without the apparent
+ * information of the template's gradient noise and of what the gain and bias explain, through
+ * the same model selection as the refinement's. */
+#include "refine_internal.h"
+#include <math.h>
+#include <string.h>
+
+#define DENSE_LEVELS 3          /* the background image and two 2x2 means of it */
+#define DENSE_MIN_SIDE 12       /* a coarser image than this a side is not made */
+#define DENSE_ITERATIONS 40     /* per level */
+#define DENSE_STEP_EPS 0.002    /* convergence: largest corner update, level px */
+#define DENSE_HIST_BINS 256     /* |residual| histogram: 1/32 grey level per bin */
+#define DENSE_SIGMA_FLOOR 0.1   /* grey levels: coarse images average the noise away */
+/* var(g) of a central difference over 2 is half a pixel's noise variance, and the residual
+ * holds two frames' noise: a quarter of the residual variance */
+#define DENSE_GRADIENT_NOISE_SHARE 0.25
+
+typedef struct dense_level {
+    const uint16_t *a, *b;
+    int w, h;
+    double unit;                /* grey levels per stored unit */
+    double scale, offset;       /* full-size x = scale * x_level + offset */
+} dense_level;
+
+typedef struct dense_solver {
+    const home_context *ctx;
+    double f, cx, cy;           /* normalisation, as the refinement's */
+    double hn[9];               /* A -> B, normalised */
+    double alpha, beta;
+    int k;                      /* parameters of the model fitted */
+    double gen[8][8];           /* their generators: update dq -> W = I + sum q_i gen_i (the
+                                   homography's entries h0..h7) */
+} dense_solver;
+
+static void mat3_mul(const double *a, const double *b, double *out)
+{
+    int r, c, e;
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) {
+            double v = 0.0;
+            for (e = 0; e < 3; e++) v += a[r * 3 + e] * b[e * 3 + c];
+            out[r * 3 + c] = v;
+        }
+}
+
+/* 2x2 sums of src (w x h) into dst (w/2 x h/2), rounded to `shift` bits fewer. */
+static void halve(const uint16_t *src, int w, int h, uint16_t *dst, int shift)
+{
+    const int w2 = w / 2, h2 = h / 2, round = shift ? 1 << (shift - 1) : 0;
+    int x, y;
+    for (y = 0; y < h2; y++) {
+        const uint16_t *r0 = src + (ptrdiff_t)(2 * y) * w, *r1 = r0 + w;
+        for (x = 0; x < w2; x++)
+            dst[(ptrdiff_t)y * w2 + x] = (uint16_t)(
+                (r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1] + round) >> shift);
+    }
+}
+
+/* The level's pixel of A as B's level coordinates under s->hn: m (3x3), L^-1 N^-1 hn N L with
+ * N: full-size x -> (x - c) / f and L: level x -> scale x + offset. */
+static void level_matrix(const dense_solver *s, const dense_level *lv, double *m)
+{
+    const double c = lv->scale / s->f;
+    const double nl[9] = {c, 0.0, (lv->offset - s->cx) / s->f, 0.0, c, (lv->offset - s->cy) / s->f,
+                          0.0, 0.0, 1.0};
+    const double nl_inv[9] = {1.0 / c, 0.0, (s->cx - lv->offset) / lv->scale, 0.0, 1.0 / c,
+                              (s->cy - lv->offset) / lv->scale, 0.0, 0.0, 1.0};
+    double t[9];
+    mat3_mul(s->hn, nl, t);
+    mat3_mul(nl_inv, t, m);
+}
+
+/* Bilinear sample of B at (x, y), grey levels; 0 outside (the caller skips it). */
+static int sample(const dense_level *lv, double x, double y, double *out)
+{
+    int ix, iy;
+    double fx, fy;
+    const uint16_t *p;
+    if (!(x >= 0.0 && y >= 0.0 && x < lv->w - 1 && y < lv->h - 1)) return 0;
+    ix = (int)x;
+    iy = (int)y;
+    fx = x - ix;
+    fy = y - iy;
+    p = lv->b + (ptrdiff_t)iy * lv->w + ix;
+    *out = lv->unit * ((1.0 - fy) * ((1.0 - fx) * p[0] + fx * p[1]) +
+                       fy * ((1.0 - fx) * p[lv->w] + fx * p[lv->w + 1]));
+    return 1;
+}
+
+static double cauchy_weight(double r, double sigma)
+{
+    const double q = r / (CAUCHY_K * sigma);
+    return 1.0 / (1.0 + q * q);
+}
+
+/* One pass over the level's interior pixels under s->hn. mode 0: the |residual| histogram;
+ * 1: the weighted sums of the gain and bias fit (sums[5]); 2: J^T W J (jtj, k x k, row stride
+ * 8), J^T W r, the sums of w and w r^2, the gradient noise's sum w D^T D (noise), the
+ * correlation's sums (corr[6] of w, w a, w b', w a^2, w b'^2, w a b') and J's weighted sums
+ * against the gain's and the bias's derivatives (cross[16]: w J a, w J; the gain's taken as A,
+ * which B matches at the optimum). Returns the pixels used. */
+static int pass(const dense_solver *s, const dense_level *lv, int mode, double sigma,
+                int32_t *hist, double *sums, double *jtj, double *jtr, double *noise,
+                double *corr, double *cross)
+{
+    double m[9];
+    const double k = s->f / lv->scale; /* level px per normalised unit */
+    int x, y, i, j, e, n = 0;
+    level_matrix(s, lv, m);
+    for (y = 1; y < lv->h - 1; y++) {
+        const uint16_t *ra = lv->a + (ptrdiff_t)y * lv->w;
+        const double v = (lv->scale * y + lv->offset - s->cy) / s->f;
+        for (x = 1; x < lv->w - 1; x++) {
+            const double a = lv->unit * ra[x], z = m[6] * x + m[7] * y + m[8];
+            double b, r, w;
+            if (!(z > 0.0) ||
+                !sample(lv, (m[0] * x + m[1] * y + m[2]) / z, (m[3] * x + m[4] * y + m[5]) / z, &b))
+                continue;
+            n++;
+            r = s->alpha * b + s->beta - a;
+            if (mode == 0) {
+                int bin = (int)(fabs(r) * 32.0);
+                hist[bin < DENSE_HIST_BINS ? bin : DENSE_HIST_BINS - 1]++;
+                continue;
+            }
+            w = cauchy_weight(r, sigma);
+            if (mode == 1) {
+                sums[0] += w;
+                sums[1] += w * b;
+                sums[2] += w * a;
+                sums[3] += w * b * b;
+                sums[4] += w * a * b;
+            } else {
+                const double u = (lv->scale * x + lv->offset - s->cx) / s->f;
+                const double gx = 0.5 * lv->unit * (ra[x + 1] - ra[x - 1]) * k;
+                const double gy = 0.5 * lv->unit * ((double)ra[x + lv->w] - ra[x - lv->w]) * k;
+                /* the warp's derivatives by h0..h7 at the identity, x then y */
+                const double dx[8] = {u, v, 1.0, 0.0, 0.0, 0.0, -u * u, -u * v};
+                const double dy[8] = {0.0, 0.0, 0.0, u, v, 1.0, -u * v, -v * v};
+                double jr[8], ddx[8], ddy[8];
+                for (i = 0; i < s->k; i++) {
+                    ddx[i] = ddy[i] = 0.0;
+                    for (e = 0; e < 8; e++) {
+                        ddx[i] += s->gen[i][e] * dx[e];
+                        ddy[i] += s->gen[i][e] * dy[e];
+                    }
+                    jr[i] = gx * ddx[i] + gy * ddy[i];
+                }
+                for (i = 0; i < s->k; i++) {
+                    cross[i] += w * jr[i] * a; /* J against the gain's and the bias's */
+                    cross[8 + i] += w * jr[i];
+                    jtr[i] += w * jr[i] * r;
+                    for (j = 0; j < s->k; j++) {
+                        jtj[i * 8 + j] += w * jr[i] * jr[j];
+                        noise[i * 8 + j] += w * k * k * (ddx[i] * ddx[j] + ddy[i] * ddy[j]);
+                    }
+                }
+                sums[0] += w;
+                sums[1] += w * r * r;
+                b = s->alpha * b + s->beta;
+                corr[0] += w;
+                corr[1] += w * a;
+                corr[2] += w * b;
+                corr[3] += w * a * a;
+                corr[4] += w * b * b;
+                corr[5] += w * a * b;
+            }
+        }
+    }
+    return n;
+}
+
+/* Robust scale of the residuals: 1.4826 x their median magnitude. */
+static double robust_sigma(const dense_solver *s, const dense_level *lv, int32_t *hist)
+{
+    int n, i, seen = 0;
+    memset(hist, 0, DENSE_HIST_BINS * sizeof *hist);
+    n = pass(s, lv, 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL);
+    for (i = 0; i < DENSE_HIST_BINS; i++) {
+        seen += hist[i];
+        if (2 * seen >= n) break;
+    }
+    return 1.4826 * (i + 0.5) / 32.0 > DENSE_SIGMA_FLOOR ? 1.4826 * (i + 0.5) / 32.0
+                                                           : DENSE_SIGMA_FLOOR;
+}
+
+/* W = I + sum dq_i gen_i (3x3). */
+static void update_matrix(const dense_solver *s, const double *dq, double *w)
+{
+    int i, e;
+    for (e = 0; e < 9; e++) w[e] = e % 4 == 0 ? 1.0 : 0.0;
+    for (i = 0; i < s->k; i++)
+        for (e = 0; e < 8; e++) w[e] += dq[i] * s->gen[i][e];
+}
+
+/* hn <- hn W(dq)^-1; 0 when W is singular. */
+static int compose_inverse(dense_solver *s, const double *dq)
+{
+    double w[9], c[9], inv[9], out[9], det;
+    int e;
+    update_matrix(s, dq, w);
+    home__cofactors3(w, c);
+    det = w[0] * c[0] + w[1] * c[1] + w[2] * c[2];
+    if (!(fabs(det) > 1e-12)) return 0;
+    for (e = 0; e < 9; e++) inv[e] = c[(e % 3) * 3 + e / 3] / det; /* C^T / det */
+    mat3_mul(s->hn, inv, out);
+    if (!(fabs(out[8]) > 1e-12)) return 0;
+    for (e = 0; e < 9; e++) s->hn[e] = out[e] / out[8];
+    return 1;
+}
+
+/* Largest corner displacement of the update dq, level px. */
+static double step_px(const dense_solver *s, const dense_level *lv, const double *dq)
+{
+    const double hu = s->cx / s->f, hv = s->cy / s->f;
+    double w[9], worst = 0.0;
+    int c;
+    update_matrix(s, dq, w);
+    for (c = 0; c < 4; c++) {
+        const double u = (c & 1) ? hu : -hu, v = (c & 2) ? hv : -hv;
+        const double z = w[6] * u + w[7] * v + w[8];
+        const double dx = (w[0] * u + w[1] * v + w[2]) / z - u;
+        const double dy = (w[3] * u + w[4] * v + w[5]) / z - v;
+        const double d = sqrt(dx * dx + dy * dy);
+        if (!(d <= worst)) worst = d;
+    }
+    return worst * s->f / lv->scale;
+}
+
+/* k x k solve (row stride 8); 0 when not positive definite. */
+static int solve_k(const double *a8, const double *b, int k, double *x)
+{
+    double a[64], l[8];
+    int i, j;
+    for (i = 0; i < 8; i++) {
+        for (j = 0; j < 8; j++) a[i * 8 + j] = i < k && j < k ? a8[i * 8 + j] : (i == j);
+        l[i] = i < k ? b[i] : 0.0;
+    }
+    if (!home__cholesky8(a)) return 0;
+    home__cholesky_solve8(a, l);
+    for (i = 0; i < k; i++) x[i] = l[i];
+    return 1;
+}
+
+typedef struct dense_fit {
+    double jtj[64], jtr[8], noise[64], corr[6], cross[16], sum_w, sum_wr2, sigma;
+    int n;
+} dense_fit;
+
+/* One Gauss-Newton iteration at the level: scale, gain and bias, then the normal equations
+ * (into fit). 0 when too few pixels overlap. */
+static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, dense_fit *fit)
+{
+    double sums[5] = {0}, det;
+    fit->sigma = robust_sigma(s, lv, hist);
+    if (pass(s, lv, 1, fit->sigma, NULL, sums, NULL, NULL, NULL, NULL, NULL) < MIN_POINTS) return 0;
+    det = sums[0] * sums[3] - sums[1] * sums[1];
+    if (det > 1e-9 * sums[0] * sums[3]) {
+        s->alpha = (sums[0] * sums[4] - sums[1] * sums[2]) / det;
+        s->beta = (sums[2] - s->alpha * sums[1]) / sums[0];
+    }
+    {
+        const double sigma = fit->sigma;
+        memset(fit, 0, sizeof *fit);
+        fit->sigma = sigma;
+    }
+    {
+        double pair[2] = {0.0, 0.0};
+        fit->n = pass(s, lv, 2, fit->sigma, NULL, pair, fit->jtj, fit->jtr, fit->noise, fit->corr,
+                      fit->cross);
+        fit->sum_w = pair[0];
+        fit->sum_wr2 = pair[1];
+    }
+    return fit->n >= MIN_POINTS;
+}
+
+/* Build the levels: the slots' background16 images, then 2x2 sums of them in the match-time
+ * buffers st->sampled (A's) and st->smoothed_b (B's). Returns the number of levels. */
+static int make_levels(const home_context *ctx, int slot, dense_level *lv)
+{
+    const home__refine_state *st = &ctx->refine;
+    uint16_t *wa = (uint16_t *)(void *)st->sampled, *wb = (uint16_t *)(void *)st->smoothed_b;
+    int n = 1;
+    lv[0].a = st->background16[slot];
+    lv[0].b = st->background16[st->next_slot ^ 1];
+    lv[0].w = st->background_w;
+    lv[0].h = st->background_h;
+    lv[0].unit = 1.0 / 16.0;
+    lv[0].scale = (double)((1 << st->background_level) * st->background_factor);
+    lv[0].offset = 0.5 * (lv[0].scale - 1.0);
+    while (n < DENSE_LEVELS && lv[n - 1].w / 2 >= DENSE_MIN_SIDE &&
+           lv[n - 1].h / 2 >= DENSE_MIN_SIDE) {
+        dense_level *c = &lv[n];
+        const dense_level *p = &lv[n - 1];
+        c->w = p->w / 2;
+        c->h = p->h / 2;
+        /* sixteenths summed to 64ths (at most 4 x 4080), then 64ths stay 64ths */
+        halve(p->a, p->w, p->h, wa, n == 1 ? 0 : 2);
+        halve(p->b, p->w, p->h, wb, n == 1 ? 0 : 2);
+        c->a = wa;
+        c->b = wb;
+        wa += (size_t)c->w * (size_t)c->h;
+        wb += (size_t)c->w * (size_t)c->h;
+        c->unit = 1.0 / 64.0;
+        c->scale = 2.0 * p->scale;
+        c->offset = 0.5 * (c->scale - 1.0);
+        n++;
+    }
+    return n;
+}
+
+/* The generators of the model's updates over h0..h7 (k of them): the most general model
+ * cfg.max_model allows. */
+static void set_model(dense_solver *s, int max_model)
+{
+    memset(s->gen, 0, sizeof s->gen);
+    if (max_model >= HOME_MODEL_AFFINE) {
+        int e;
+        s->k = max_model >= HOME_MODEL_HOMOGRAPHY ? 8 : 6;
+        for (e = 0; e < s->k; e++) s->gen[e][e] = 1.0;
+        return;
+    }
+    s->gen[0][2] = 1.0; /* translation */
+    s->gen[1][5] = 1.0;
+    s->k = 2;
+    if (max_model >= HOME_MODEL_SIMILARITY) {
+        s->gen[2][0] = s->gen[2][4] = 1.0; /* scale */
+        s->gen[3][1] = -1.0;               /* rotation */
+        s->gen[3][3] = 1.0;
+        s->k = 4;
+    }
+}
+
+int home__refine_dense(home_context *ctx, int slot, home_result *result, double *reach_px)
+{
+    const home__refine_state *st = &ctx->refine;
+    dense_level lv[DENSE_LEVELS];
+    dense_solver s;
+    dense_fit fit;
+    int32_t hist[DENSE_HIST_BINS];
+    int levels, level, it, i, j, p, q, converged = 0;
+    double info[64], basis[8][8], g[64], ginv[64], core[64];
+    home__model_problem mp;
+    home__model_choice choice;
+    double resid_var, var_g;
+
+    *reach_px = 0.0;
+    if (!st->levels || ctx->cfg.max_model < HOME_MODEL_TRANSLATION) return 0;
+    memset(&s, 0, sizeof s);
+    s.ctx = ctx;
+    s.cx = 0.5 * (ctx->cfg.width - 1);
+    s.cy = 0.5 * (ctx->cfg.height - 1);
+    s.f = 0.5 * (ctx->cfg.width > ctx->cfg.height ? ctx->cfg.width : ctx->cfg.height);
+    memcpy(s.hn, home__refine_identity, sizeof s.hn);
+    s.alpha = 1.0;
+    s.beta = 0.0;
+    set_model(&s, ctx->cfg.max_model);
+    levels = make_levels(ctx, slot, lv);
+    *reach_px = lv[levels - 1].scale;
+    for (level = levels - 1; level >= 0; level--) {
+        converged = 0;
+        for (it = 0; it < DENSE_ITERATIONS && !converged; it++) {
+            double dq[8];
+            if (!iterate(&s, &lv[level], hist, &fit) || !solve_k(fit.jtj, fit.jtr, s.k, dq) ||
+                !compose_inverse(&s, dq))
+                return 0;
+            converged = step_px(&s, &lv[level], dq) < DENSE_STEP_EPS;
+        }
+    }
+    if (!converged) {
+        result->refine_status = HOME_REFINE_NOT_CONVERGED;
+        return 0;
+    }
+    /* the statistics at the estimate */
+    if (!iterate(&s, &lv[0], hist, &fit)) return 0;
+    resid_var = fit.sum_w > s.k ? fit.sum_wr2 / (fit.sum_w - s.k) : fit.sum_wr2;
+    var_g = DENSE_GRADIENT_NOISE_SHARE * resid_var;
+    for (i = 0; i < 64; i++) info[i] = fit.jtj[i] - var_g * fit.noise[i];
+    /* less what the gain and bias explain as well (a shading ramp's shift is a bias change):
+     * the Schur complement of their block, P = [A, 1], P^T W P from the correlation's sums */
+    {
+        const double *c = fit.corr, pp00 = c[3], pp01 = c[1], pp11 = c[0];
+        const double det = pp00 * pp11 - pp01 * pp01;
+        if (!(det > 0.0)) return 0;
+        for (i = 0; i < s.k; i++)
+            for (j = 0; j < s.k; j++) {
+                const double ai = fit.cross[i], bi = fit.cross[8 + i];
+                const double aj = fit.cross[j], bj = fit.cross[8 + j];
+                info[i * 8 + j] -=
+                    (ai * (pp11 * aj - pp01 * bj) + bi * (pp00 * bj - pp01 * aj)) / det;
+            }
+    }
+    /* in the homography's entries (h8 = 1): dh = B dq, B's columns the derivatives of
+     * hn (I + gen_i) normalised, and M = B (B^T B)^-1 I (B^T B)^-1 B^T */
+    for (j = 0; j < s.k; j++) {
+        double w[9], t[9];
+        int e;
+        for (e = 0; e < 9; e++) w[e] = e < 8 ? s.gen[j][e] : 0.0;
+        mat3_mul(s.hn, w, t);
+        for (e = 0; e < 8; e++) basis[e][j] = t[e] - s.hn[e] * t[8];
+    }
+    for (i = 0; i < s.k; i++)
+        for (j = 0; j < s.k; j++) {
+            g[i * 8 + j] = 0.0;
+            for (p = 0; p < 8; p++) g[i * 8 + j] += basis[p][i] * basis[p][j];
+        }
+    for (j = 0; j < s.k; j++) { /* (B^T B)^-1, column by column */
+        double col[8] = {0, 0, 0, 0, 0, 0, 0, 0}, x[8];
+        col[j] = 1.0;
+        if (!solve_k(g, col, s.k, x)) return 0;
+        for (i = 0; i < s.k; i++) ginv[i * 8 + j] = x[i];
+    }
+    for (i = 0; i < s.k; i++)
+        for (j = 0; j < s.k; j++) {
+            double v = 0.0;
+            for (p = 0; p < s.k; p++)
+                for (q = 0; q < s.k; q++) v += ginv[i * 8 + p] * info[p * 8 + q] * ginv[q * 8 + j];
+            core[i * 8 + j] = v;
+        }
+    memset(&mp, 0, sizeof mp);
+    mp.space = HOME__SPACE_H;
+    for (i = 0; i < 8; i++) {
+        mp.p[i] = s.hn[i];
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (p = 0; p < s.k; p++)
+                for (q = 0; q < s.k; q++) v += basis[i][p] * core[p * 8 + q] * basis[j][q];
+            mp.info[i * 8 + j] = v / (resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE);
+        }
+    }
+    mp.penalty = log((double)fit.n);
+    mp.max_model = ctx->cfg.max_model;
+    mp.max_params = s.k;
+    mp.scale = s.f;
+    mp.cx = s.cx;
+    mp.cy = s.cy;
+    if (!home__select_model(&mp, &choice)) {
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return 0;
+    }
+    /* the correlation and the consistent share at the estimate */
+    {
+        const double *c = fit.corr;
+        const double va = c[3] / c[0] - (c[1] / c[0]) * (c[1] / c[0]);
+        const double vb = c[4] / c[0] - (c[2] / c[0]) * (c[2] / c[0]);
+        const double cab = c[5] / c[0] - (c[1] / c[0]) * (c[2] / c[0]);
+        const int within = (int)(3.0 * fit.sigma * 32.0);
+        int in = 0, n;
+        result->refine_zncc = va > 0.0 && vb > 0.0 ? cab / sqrt(va * vb) : 0.0;
+        memset(hist, 0, sizeof hist);
+        n = pass(&s, &lv[0], 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL);
+        for (i = 0; i < DENSE_HIST_BINS && i < within; i++) in += hist[i];
+        result->refine_inlier_share = n ? (double)in / n : 0.0;
+    }
+    {
+        /* normalised -> pixels: H = N^-1 hn N, N: x -> (x - c) / f */
+        const double n[9] = {1.0 / s.f, 0.0, -s.cx / s.f, 0.0, 1.0 / s.f, -s.cy / s.f, 0, 0, 1};
+        const double n_inv[9] = {s.f, 0.0, s.cx, 0.0, s.f, s.cy, 0, 0, 1};
+        double hc[9], t[9], h[9];
+        memcpy(hc, choice.p, 8 * sizeof *hc);
+        hc[8] = 1.0;
+        mat3_mul(hc, n, t);
+        mat3_mul(n_inv, t, h);
+        for (i = 0; i < 9; i++) result->H[i] = h[i] / h[8];
+    }
+    if (!home__homography_plausible(result->H, ctx->cfg.width, ctx->cfg.height)) {
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return 0;
+    }
+    result->model = choice.model;
+    result->sigma_px = choice.sigma_px;
+    result->refined = 1;
+    result->refine_status = HOME_REFINE_DENSE;
+    return 1;
+}
