@@ -10,7 +10,10 @@
  * fine from the identity, every interior pixel a template point; a gain and bias and Cauchy
  * weights as in the refinement. The predicted error comes from J^T W J without the apparent
  * information of the template's gradient noise and of what the gain and bias explain, through
- * the same model selection as the refinement's. */
+ * the same model selection as the refinement's: the larger of its homoscedastic prediction
+ * and the sandwich with the scores summed over blocks of pixels (residuals that are not
+ * independent: an edge the motion model does not quite fit, blur that differs between
+ * frames). */
 #include "refine_internal.h"
 #include <math.h>
 #include <string.h>
@@ -21,6 +24,8 @@
 #define DENSE_STEP_EPS 0.002    /* convergence: largest corner update, level px */
 #define DENSE_HIST_BINS 256     /* |residual| histogram: 1/32 grey level per bin */
 #define DENSE_SIGMA_FLOOR 0.1   /* grey levels: coarse images average the noise away */
+#define CLUSTER_SIDE 8          /* the covariance's blocks of pixels, finest dense level */
+#define DENSE_MAX_CLUSTERS 32   /* block columns at most (wider images share the last) */
 /* var(g) of a central difference over 2 is half a pixel's noise variance, and the residual
  * holds two frames' noise: a quarter of the residual variance */
 #define DENSE_GRADIENT_NOISE_SHARE 0.25
@@ -41,17 +46,6 @@ typedef struct dense_solver {
     double gen[8][8];           /* their generators: update dq -> W = I + sum q_i gen_i (the
                                    homography's entries h0..h7) */
 } dense_solver;
-
-static void mat3_mul(const double *a, const double *b, double *out)
-{
-    int r, c, e;
-    for (r = 0; r < 3; r++)
-        for (c = 0; c < 3; c++) {
-            double v = 0.0;
-            for (e = 0; e < 3; e++) v += a[r * 3 + e] * b[e * 3 + c];
-            out[r * 3 + c] = v;
-        }
-}
 
 /* 2x2 sums of src (w x h) into dst (w/2 x h/2), rounded to `shift` bits fewer. */
 static void halve(const uint16_t *src, int w, int h, uint16_t *dst, int shift)
@@ -75,9 +69,9 @@ static void level_matrix(const dense_solver *s, const dense_level *lv, double *m
                           0.0, 0.0, 1.0};
     const double nl_inv[9] = {1.0 / c, 0.0, (s->cx - lv->offset) / lv->scale, 0.0, 1.0 / c,
                               (s->cy - lv->offset) / lv->scale, 0.0, 0.0, 1.0};
-    double t[9];
-    mat3_mul(s->hn, nl, t);
-    mat3_mul(nl_inv, t, m);
+    double t[9] = {0}; /* zeroed for gcc's -fanalyzer (make lint) */
+    home__refine_mat3_mul(s->hn, nl, t);
+    home__refine_mat3_mul(nl_inv, t, m);
 }
 
 /* Bilinear sample of B at (x, y), grey levels; 0 outside (the caller skips it). */
@@ -103,6 +97,29 @@ static double cauchy_weight(double r, double sigma)
     return 1.0 / (1.0 + q * q);
 }
 
+/* The pixel's row of J (k entries: the template's gradient times the warp's derivatives by
+ * the model's parameters, normalised units) and those derivatives (x, y). */
+static void pixel_jacobian(const dense_solver *s, const dense_level *lv, const uint16_t *ra,
+                           int x, double v, double *jr, double *ddx, double *ddy)
+{
+    const double k = s->f / lv->scale; /* level px per normalised unit */
+    const double u = (lv->scale * x + lv->offset - s->cx) / s->f;
+    const double gx = 0.5 * lv->unit * (ra[x + 1] - ra[x - 1]) * k;
+    const double gy = 0.5 * lv->unit * ((double)ra[x + lv->w] - ra[x - lv->w]) * k;
+    /* the warp's derivatives by h0..h7 at the identity, x then y */
+    const double dx[8] = {u, v, 1.0, 0.0, 0.0, 0.0, -u * u, -u * v};
+    const double dy[8] = {0.0, 0.0, 0.0, u, v, 1.0, -u * v, -v * v};
+    int i, e;
+    for (i = 0; i < s->k; i++) {
+        ddx[i] = ddy[i] = 0.0;
+        for (e = 0; e < 8; e++) {
+            ddx[i] += s->gen[i][e] * dx[e];
+            ddy[i] += s->gen[i][e] * dy[e];
+        }
+        jr[i] = gx * ddx[i] + gy * ddy[i];
+    }
+}
+
 /* One pass over the level's interior pixels under s->hn. mode 0: the |residual| histogram;
  * 1: the weighted sums of the gain and bias fit (sums[5]); 2: J^T W J (jtj, k x k, row stride
  * 8), J^T W r, the sums of w and w r^2, the gradient noise's sum w D^T D (noise), the
@@ -115,7 +132,7 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
 {
     double m[9];
     const double k = s->f / lv->scale; /* level px per normalised unit */
-    int x, y, i, j, e, n = 0;
+    int x, y, i, j, n = 0;
     level_matrix(s, lv, m);
     for (y = 1; y < lv->h - 1; y++) {
         const uint16_t *ra = lv->a + (ptrdiff_t)y * lv->w;
@@ -141,21 +158,8 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
                 sums[3] += w * b * b;
                 sums[4] += w * a * b;
             } else {
-                const double u = (lv->scale * x + lv->offset - s->cx) / s->f;
-                const double gx = 0.5 * lv->unit * (ra[x + 1] - ra[x - 1]) * k;
-                const double gy = 0.5 * lv->unit * ((double)ra[x + lv->w] - ra[x - lv->w]) * k;
-                /* the warp's derivatives by h0..h7 at the identity, x then y */
-                const double dx[8] = {u, v, 1.0, 0.0, 0.0, 0.0, -u * u, -u * v};
-                const double dy[8] = {0.0, 0.0, 0.0, u, v, 1.0, -u * v, -v * v};
                 double jr[8], ddx[8], ddy[8];
-                for (i = 0; i < s->k; i++) {
-                    ddx[i] = ddy[i] = 0.0;
-                    for (e = 0; e < 8; e++) {
-                        ddx[i] += s->gen[i][e] * dx[e];
-                        ddy[i] += s->gen[i][e] * dy[e];
-                    }
-                    jr[i] = gx * ddx[i] + gy * ddy[i];
-                }
+                pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
                 for (i = 0; i < s->k; i++) {
                     cross[i] += w * jr[i] * a; /* J against the gain's and the bias's */
                     cross[8 + i] += w * jr[i];
@@ -178,6 +182,45 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
         }
     }
     return n;
+}
+
+/* The scores' spread, clustered: sum over blocks of CLUSTER_SIDE^2 pixels of (sum w r J)
+ * (sum w r J)^T (k x k, row stride 8). Residuals that are not independent from pixel to pixel
+ * (an edge the model does not quite fit, blur that differs between the frames) add up within
+ * a block, so the covariance (J^T W J)^-1 meat (J^T W J)^-1 sees them. */
+static void cluster_meat(const dense_solver *s, const dense_level *lv, double sigma,
+                         double *meat)
+{
+    double m[9], score[DENSE_MAX_CLUSTERS][8];
+    const int columns = (lv->w + CLUSTER_SIDE - 1) / CLUSTER_SIDE;
+    int x, y, i, j, c;
+    level_matrix(s, lv, m);
+    memset(meat, 0, 64 * sizeof *meat);
+    memset(score, 0, sizeof score);
+    for (y = 1; y < lv->h - 1; y++) {
+        const uint16_t *ra = lv->a + (ptrdiff_t)y * lv->w;
+        const double v = (lv->scale * y + lv->offset - s->cy) / s->f;
+        for (x = 1; x < lv->w - 1; x++) {
+            const double a = lv->unit * ra[x], z = m[6] * x + m[7] * y + m[8];
+            double b, r, w, jr[8], ddx[8], ddy[8];
+            double *sc = score[x / CLUSTER_SIDE < DENSE_MAX_CLUSTERS ? x / CLUSTER_SIDE
+                                                                      : DENSE_MAX_CLUSTERS - 1];
+            if (!(z > 0.0) ||
+                !sample(lv, (m[0] * x + m[1] * y + m[2]) / z, (m[3] * x + m[4] * y + m[5]) / z, &b))
+                continue;
+            r = s->alpha * b + s->beta - a;
+            w = cauchy_weight(r, sigma);
+            pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
+            for (i = 0; i < s->k; i++) sc[i] += w * r * jr[i];
+        }
+        if (y % CLUSTER_SIDE == CLUSTER_SIDE - 1 || y == lv->h - 2) {
+            for (c = 0; c < columns && c < DENSE_MAX_CLUSTERS; c++) {
+                for (i = 0; i < s->k; i++)
+                    for (j = 0; j < s->k; j++) meat[i * 8 + j] += score[c][i] * score[c][j];
+            }
+            memset(score, 0, sizeof score);
+        }
+    }
 }
 
 /* Robust scale of the residuals: 1.4826 x their median magnitude. */
@@ -206,14 +249,11 @@ static void update_matrix(const dense_solver *s, const double *dq, double *w)
 /* hn <- hn W(dq)^-1; 0 when W is singular. */
 static int compose_inverse(dense_solver *s, const double *dq)
 {
-    double w[9], c[9], inv[9], out[9], det;
+    double w[9], inv[9] = {0}, out[9] = {0};
     int e;
     update_matrix(s, dq, w);
-    home__cofactors3(w, c);
-    det = w[0] * c[0] + w[1] * c[1] + w[2] * c[2];
-    if (!(fabs(det) > 1e-12)) return 0;
-    for (e = 0; e < 9; e++) inv[e] = c[(e % 3) * 3 + e / 3] / det; /* C^T / det */
-    mat3_mul(s->hn, inv, out);
+    if (!home__refine_mat3_inv(w, inv)) return 0;
+    home__refine_mat3_mul(s->hn, inv, out);
     if (!(fabs(out[8]) > 1e-12)) return 0;
     for (e = 0; e < 9; e++) s->hn[e] = out[e] / out[8];
     return 1;
@@ -319,6 +359,41 @@ static int make_levels(const home_context *ctx, int slot, dense_level *lv)
     return n;
 }
 
+/* Model selection over the information infoq of the k parameters (row stride 8), carried to
+ * the homography's entries: M = B (B^T B)^-1 infoq (B^T B)^-1 B^T (ginv: (B^T B)^-1). */
+static int choose(const dense_solver *s, const double *infoq, double basis[8][8],
+                  const double *ginv, int n, home__model_choice *choice)
+{
+    home__model_problem mp;
+    double core[64];
+    int i, j, p, q;
+    for (i = 0; i < s->k; i++)
+        for (j = 0; j < s->k; j++) {
+            double v = 0.0;
+            for (p = 0; p < s->k; p++)
+                for (q = 0; q < s->k; q++) v += ginv[i * 8 + p] * infoq[p * 8 + q] * ginv[q * 8 + j];
+            core[i * 8 + j] = v;
+        }
+    memset(&mp, 0, sizeof mp);
+    mp.space = HOME__SPACE_H;
+    for (i = 0; i < 8; i++) {
+        mp.p[i] = s->hn[i];
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (p = 0; p < s->k; p++)
+                for (q = 0; q < s->k; q++) v += basis[i][p] * core[p * 8 + q] * basis[j][q];
+            mp.info[i * 8 + j] = v;
+        }
+    }
+    mp.penalty = log((double)n);
+    mp.max_model = s->ctx->cfg.max_model;
+    mp.max_params = s->k;
+    mp.scale = s->f;
+    mp.cx = s->cx;
+    mp.cy = s->cy;
+    return home__select_model(&mp, choice);
+}
+
 /* The generators of the model's updates over h0..h7 (k of them): the most general model
  * cfg.max_model allows. */
 static void set_model(dense_solver *s, int max_model)
@@ -348,10 +423,9 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     dense_solver s;
     dense_fit fit;
     int32_t hist[DENSE_HIST_BINS];
-    int levels, level, it, i, j, p, q, converged = 0;
-    double info[64], basis[8][8], g[64], ginv[64], core[64];
-    home__model_problem mp;
-    home__model_choice choice;
+    int levels, level, it, i, j, p, converged = 0;
+    double info[64], basis[8][8], g[64], ginv[64], info_h[64], info_s[64], meat[64], t8[64];
+    home__model_choice choice, sandwich;
     double resid_var, var_g;
 
     *reach_px = 0.0;
@@ -403,10 +477,10 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     /* in the homography's entries (h8 = 1): dh = B dq, B's columns the derivatives of
      * hn (I + gen_i) normalised, and M = B (B^T B)^-1 I (B^T B)^-1 B^T */
     for (j = 0; j < s.k; j++) {
-        double w[9], t[9];
+        double w[9], t[9] = {0};
         int e;
         for (e = 0; e < 9; e++) w[e] = e < 8 ? s.gen[j][e] : 0.0;
-        mat3_mul(s.hn, w, t);
+        home__refine_mat3_mul(s.hn, w, t);
         for (e = 0; e < 8; e++) basis[e][j] = t[e] - s.hn[e] * t[8];
     }
     for (i = 0; i < s.k; i++)
@@ -420,34 +494,28 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         if (!solve_k(g, col, s.k, x)) return 0;
         for (i = 0; i < s.k; i++) ginv[i * 8 + j] = x[i];
     }
+    /* two predictions: J^T W J over the residual variance (times the refinement's scale), and
+     * the clustered sandwich (J^T W J) meat^-1 (J^T W J); the larger predicted error stands */
+    for (i = 0; i < 64; i++) info_h[i] = info[i] / (resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE);
+    cluster_meat(&s, &lv[0], fit.sigma, meat);
+    for (j = 0; j < s.k; j++) { /* meat^-1 info, column by column */
+        double col[8], x[8];
+        for (i = 0; i < 8; i++) col[i] = i < s.k ? info[i * 8 + j] : 0.0;
+        if (!solve_k(meat, col, s.k, x)) return 0;
+        for (i = 0; i < s.k; i++) t8[i * 8 + j] = x[i];
+    }
     for (i = 0; i < s.k; i++)
         for (j = 0; j < s.k; j++) {
             double v = 0.0;
-            for (p = 0; p < s.k; p++)
-                for (q = 0; q < s.k; q++) v += ginv[i * 8 + p] * info[p * 8 + q] * ginv[q * 8 + j];
-            core[i * 8 + j] = v;
+            for (p = 0; p < s.k; p++) v += info[i * 8 + p] * t8[p * 8 + j];
+            info_s[i * 8 + j] = v;
         }
-    memset(&mp, 0, sizeof mp);
-    mp.space = HOME__SPACE_H;
-    for (i = 0; i < 8; i++) {
-        mp.p[i] = s.hn[i];
-        for (j = 0; j < 8; j++) {
-            double v = 0.0;
-            for (p = 0; p < s.k; p++)
-                for (q = 0; q < s.k; q++) v += basis[i][p] * core[p * 8 + q] * basis[j][q];
-            mp.info[i * 8 + j] = v / (resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE);
-        }
-    }
-    mp.penalty = log((double)fit.n);
-    mp.max_model = ctx->cfg.max_model;
-    mp.max_params = s.k;
-    mp.scale = s.f;
-    mp.cx = s.cx;
-    mp.cy = s.cy;
-    if (!home__select_model(&mp, &choice)) {
+    if (!choose(&s, info_h, basis, ginv, fit.n, &choice) ||
+        !choose(&s, info_s, basis, ginv, fit.n, &sandwich)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0;
     }
+    if (sandwich.sigma_px > choice.sigma_px) choice = sandwich;
     /* the correlation and the consistent share at the estimate */
     {
         const double *c = fit.corr;
@@ -466,11 +534,11 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         /* normalised -> pixels: H = N^-1 hn N, N: x -> (x - c) / f */
         const double n[9] = {1.0 / s.f, 0.0, -s.cx / s.f, 0.0, 1.0 / s.f, -s.cy / s.f, 0, 0, 1};
         const double n_inv[9] = {s.f, 0.0, s.cx, 0.0, s.f, s.cy, 0, 0, 1};
-        double hc[9], t[9], h[9];
+        double hc[9], t[9] = {0}, h[9] = {0};
         memcpy(hc, choice.p, 8 * sizeof *hc);
         hc[8] = 1.0;
-        mat3_mul(hc, n, t);
-        mat3_mul(n_inv, t, h);
+        home__refine_mat3_mul(hc, n, t);
+        home__refine_mat3_mul(n_inv, t, h);
         for (i = 0; i < 9; i++) result->H[i] = h[i] / h[8];
     }
     if (!home__homography_plausible(result->H, ctx->cfg.width, ctx->cfg.height)) {

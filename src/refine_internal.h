@@ -94,6 +94,9 @@ static inline double robust_cost(double r, double c)
 int home__refine_match_capacity(const home_config *cfg);
 
 /* refine_solve.c */
+/* 3x3 row-major product out = a b; inverse (0 when singular) */
+void home__refine_mat3_mul(const double *a, const double *b, double *out);
+int home__refine_mat3_inv(const double *m, double *out);
 void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver *s);
 void home__refine_to_normalised(const home__refine_solver *s, const double *h, double *hn);
 void home__refine_level_matrix(const home__refine_solver *s, const double *hn, int level,

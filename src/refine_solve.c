@@ -28,7 +28,7 @@
 
 const double home__refine_identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 
-static void mat3_mul(const double *a, const double *b, double *out)
+void home__refine_mat3_mul(const double *a, const double *b, double *out)
 {
     int i, j;
     for (i = 0; i < 3; i++)
@@ -37,7 +37,7 @@ static void mat3_mul(const double *a, const double *b, double *out)
                              a[i * 3 + 2] * b[2 * 3 + j];
 }
 
-static int mat3_inv(const double *m, double *out)
+int home__refine_mat3_inv(const double *m, double *out)
 {
     double d = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
                m[2] * (m[3] * m[7] - m[4] * m[6]);
@@ -67,8 +67,8 @@ void home__refine_to_normalised(const home__refine_solver *s, const double *h, d
     const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
     const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
     double t[9] = {0}; /* all written by mat3_mul; zeroed for gcc's -fanalyzer (make lint) */
-    mat3_mul(n, h, t);
-    mat3_mul(t, ni, hn);
+    home__refine_mat3_mul(n, h, t);
+    home__refine_mat3_mul(t, ni, hn);
     normalise9(hn);
 }
 
@@ -77,8 +77,8 @@ static void to_pixels(const home__refine_solver *s, const double *hn, double *h)
     const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
     const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
     double t[9] = {0}; /* all written by mat3_mul; zeroed for gcc's -fanalyzer (make lint) */
-    mat3_mul(ni, hn, t);
-    mat3_mul(t, n, h);
+    home__refine_mat3_mul(ni, hn, t);
+    home__refine_mat3_mul(t, n, h);
     normalise9(h);
 }
 
@@ -91,8 +91,8 @@ void home__refine_level_matrix(const home__refine_solver *s, const double *hn, i
     const double p[9] = {s->f / sc, 0, (s->cx - o) / sc, 0, s->f / sc, (s->cy - o) / sc, 0, 0, 1};
     double t[9] = {0}, r[9]; /* t: gcc -fanalyzer loses it through mat3_mul's loops */
     int k;
-    mat3_mul(hn, q, t);
-    mat3_mul(p, t, r);
+    home__refine_mat3_mul(hn, q, t);
+    home__refine_mat3_mul(p, t, r);
     for (k = 0; k < 9; k++) m[k] = (float)r[k];
 }
 
@@ -272,8 +272,8 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     hd[0] = 1 + dp[0]; hd[1] = dp[1]; hd[2] = dp[2];
     hd[3] = dp[3]; hd[4] = 1 + dp[4]; hd[5] = dp[5];
     hd[6] = dp[6]; hd[7] = dp[7]; hd[8] = 1;
-    if (!mat3_inv(hd, hdi)) return 0;
-    mat3_mul(s->hn, hdi, t);
+    if (!home__refine_mat3_inv(hd, hdi)) return 0;
+    home__refine_mat3_mul(s->hn, hdi, t);
     normalise9(t);
     for (i = 0; i < 9; i++)
         if (!isfinite(t[i])) return 0;
@@ -475,8 +475,8 @@ static int update_between(const double *hn, const double *hn2, double *dp)
 {
     double inv[9], m[9];
     int k;
-    if (!mat3_inv(hn2, inv)) return 0;
-    mat3_mul(inv, hn, m);
+    if (!home__refine_mat3_inv(hn2, inv)) return 0;
+    home__refine_mat3_mul(inv, hn, m);
     if (!(fabs(m[8]) > 1e-12)) return 0;
     normalise9(m);
     for (k = 0; k < 8; k++) dp[k] = m[k] - (k == 0 || k == 4 ? 1.0 : 0.0);
