@@ -323,9 +323,8 @@ typedef struct home_result {
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the
  * identity is tried; it vouches like an overruling refinement and must stay within
  * refine_trust_px of the identity. Where that fails too (and nothing made the pair
- * inconsistent), every pixel of the quarter-size frames is aligned from the identity, coarse to
- * fine, in the most general model max_model allows (HOME_REFINE_DENSE: slow shading, a soft
- * shadow): it vouches the same way, reaches a pixel of its coarsest image (16 px at 640x360),
+ * inconsistent), with max_model a homography, every pixel of the quarter-size frames is
+ * aligned from the identity, coarse to fine (HOME_REFINE_DENSE: slow shading, a soft shadow): it vouches the same way, reaches a pixel of its coarsest image (16 px at 640x360),
  * and the refinement's points, where they determine an optimum from it, must find it within
  * 3 sigma_px.
  *

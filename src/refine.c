@@ -167,6 +167,31 @@ static int vouches(const home_context *ctx, const home_result *r, int whole_fram
            (whole_frame ? correlated && consistent : correlated || consistent);
 }
 
+/* home__refine_dense() on frames id_a (slot) and id_b, or its stored answer when it ran on
+ * them last with the same max_model (home_register()'s passes share the frames). */
+static int dense_alignment(home_context *ctx, int slot, uint32_t id_a, uint32_t id_b,
+                           home_result *dense, double *reach)
+{
+    home__refine_state *st = &ctx->refine;
+    if (!(st->dense_ids[0] == id_a && st->dense_ids[1] == id_b &&
+          st->dense_model == ctx->cfg.max_model)) {
+        st->dense_answer = *dense;
+        st->dense_found = home__refine_dense(ctx, slot, &st->dense_answer, &st->dense_reach);
+        st->dense_ids[0] = id_a;
+        st->dense_ids[1] = id_b;
+        st->dense_model = ctx->cfg.max_model;
+    }
+    memcpy(dense->H, st->dense_answer.H, sizeof dense->H);
+    dense->model = st->dense_answer.model;
+    dense->sigma_px = st->dense_answer.sigma_px;
+    dense->refine_zncc = st->dense_answer.refine_zncc;
+    dense->refine_inlier_share = st->dense_answer.refine_inlier_share;
+    dense->refined = st->dense_answer.refined;
+    dense->refine_status = st->dense_answer.refine_status;
+    *reach = st->dense_reach;
+    return st->dense_found;
+}
+
 /* Do the template points, where they determine an optimum from the dense estimate, find it
  * there too (within 3 sigma_px of either)? A few edges over wide shaded areas: the shading
  * pulls the dense fit off what the edges say. */
@@ -263,12 +288,16 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     }
     /* frames too faint for HOME's lines and for the refinement's points (no failure of
      * consistency: nothing refutes another answer) may still hold a motion in the slow
-     * shading of all their pixels; it vouches like direct alignment without an estimate */
-    if (!trial.ok && !result->ok && trial.failure != HOME_FAIL_INCONSISTENT) {
+     * shading of all their pixels; it vouches like direct alignment without an estimate.
+     * Only with a homography to compare simpler models against: a similarity fitted alone to
+     * a horizon in fog (the stabiliser's cap) predicted too little error (docs/trust.md) */
+    if (!trial.ok && !result->ok && trial.failure != HOME_FAIL_INCONSISTENT &&
+        ctx->cfg.max_model == HOME_MODEL_HOMOGRAPHY) {
         home_result dense = *result;
         const double reach = ctx->cfg.refine_trust_px * ctx->hough_scale;
         double dense_reach;
-        if (home__refine_dense(ctx, slot, &dense, &dense_reach) && vouches(ctx, &dense, 1) &&
+        if (dense_alignment(ctx, slot, id_a, id_b, &dense, &dense_reach) &&
+            vouches(ctx, &dense, 1) &&
             dense.sigma_px <= DENSE_SIGMA_SHARE * ctx->cfg.max_sigma_px &&
             corner_distance(ctx, dense.H, home__refine_identity) <=
                 (dense_reach > reach ? dense_reach : reach) &&

@@ -4,8 +4,8 @@
  * translation or a similarity well (docs/trust.md, session 20).
  *
  * Method: inverse-compositional Gauss-Newton of the most general motion cfg.max_model allows
- * (a homography by default: a similarity fitted to a perspective motion is wrong with a small
- * predicted error) on the two slots' background16 images (quarter size, at most
+ * (refine.c calls it with a homography: a similarity fitted to a perspective motion is wrong
+ * with a small predicted error) on the two slots' background16 images (quarter size, at most
  * HOME__BACKGROUND_PIXELS, in sixteenths of a grey level) and two 2x2 means of them, coarse to
  * fine from the identity, every interior pixel a template point; a gain and bias and Cauchy
  * weights as in the refinement. The predicted error comes from J^T W J without the apparent
@@ -20,8 +20,8 @@
 
 #define DENSE_LEVELS 3          /* the background image and two 2x2 means of it */
 #define DENSE_MIN_SIDE 12       /* a coarser image than this a side is not made */
-#define DENSE_ITERATIONS 40     /* per level */
-#define DENSE_STEP_EPS 0.002    /* convergence: largest corner update, level px */
+#define DENSE_ITERATIONS 15     /* per level: one that does not converge ends the alignment */
+#define DENSE_STEP_EPS 0.01     /* convergence: largest corner update, level px */
 #define DENSE_HIST_BINS 256     /* |residual| histogram: 1/32 grey level per bin */
 #define DENSE_SIGMA_FLOOR 0.1   /* grey levels: coarse images average the noise away */
 #define CLUSTER_SIDE 8          /* the covariance's blocks of pixels, finest dense level */
@@ -297,12 +297,14 @@ typedef struct dense_fit {
     int n;
 } dense_fit;
 
-/* One Gauss-Newton iteration at the level: scale, gain and bias, then the normal equations
- * (into fit). 0 when too few pixels overlap. */
-static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, dense_fit *fit)
+/* One Gauss-Newton iteration at the level: the residuals' scale (rescale: anew, else
+ * fit->sigma's), gain and bias, then the normal equations (into fit). 0 when too few pixels
+ * overlap. */
+static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int rescale,
+                   dense_fit *fit)
 {
     double sums[5] = {0}, det;
-    fit->sigma = robust_sigma(s, lv, hist);
+    if (rescale) fit->sigma = robust_sigma(s, lv, hist);
     if (pass(s, lv, 1, fit->sigma, NULL, sums, NULL, NULL, NULL, NULL, NULL) < MIN_POINTS) return 0;
     det = sums[0] * sums[3] - sums[1] * sums[1];
     if (det > 1e-9 * sums[0] * sums[3]) {
@@ -443,20 +445,21 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     *reach_px = lv[levels - 1].scale;
     for (level = levels - 1; level >= 0; level--) {
         converged = 0;
+        /* the residuals' scale once per level: it changes little within one */
         for (it = 0; it < DENSE_ITERATIONS && !converged; it++) {
             double dq[8];
-            if (!iterate(&s, &lv[level], hist, &fit) || !solve_k(fit.jtj, fit.jtr, s.k, dq) ||
-                !compose_inverse(&s, dq))
+            if (!iterate(&s, &lv[level], hist, it == 0, &fit) ||
+                !solve_k(fit.jtj, fit.jtr, s.k, dq) || !compose_inverse(&s, dq))
                 return 0;
             converged = step_px(&s, &lv[level], dq) < DENSE_STEP_EPS;
         }
-    }
-    if (!converged) {
-        result->refine_status = HOME_REFINE_NOT_CONVERGED;
-        return 0;
+        if (!converged) { /* a motion the frames do not determine slides (a horizon in fog) */
+            result->refine_status = HOME_REFINE_NOT_CONVERGED;
+            return 0;
+        }
     }
     /* the statistics at the estimate */
-    if (!iterate(&s, &lv[0], hist, &fit)) return 0;
+    if (!iterate(&s, &lv[0], hist, 1, &fit)) return 0;
     resid_var = fit.sum_w > s.k ? fit.sum_wr2 / (fit.sum_w - s.k) : fit.sum_wr2;
     var_g = DENSE_GRADIENT_NOISE_SHARE * resid_var;
     for (i = 0; i < 64; i++) info[i] = fit.jtj[i] - var_g * fit.noise[i];
