@@ -266,8 +266,8 @@ enum home_refine_status {
                                      sigma_px at least the period, not ok (HOME_FAIL_UNCERTAIN) */
     HOME_REFINE_DENSE             /* frames too faint for HOME and for the refinement's points
                                      (slow shading, a soft shadow): aligned from the identity
-                                     with every pixel of their quarter-size images, a
-                                     translation or a similarity */
+                                     with every pixel of their quarter-size images (a
+                                     homography, then the simplest model it supports) */
 };
 
 /* Name of a refinement status ("off", "accepted", ...; "unknown" when out of range). */
@@ -324,9 +324,10 @@ typedef struct home_result {
  * identity is tried; it vouches like an overruling refinement and must stay within
  * refine_trust_px of the identity. Where that fails too (and nothing made the pair
  * inconsistent), with max_model a homography, every pixel of the quarter-size frames is
- * aligned from the identity, coarse to fine (HOME_REFINE_DENSE: slow shading, a soft shadow): it vouches the same way, reaches a pixel of its coarsest image (16 px at 640x360),
- * and the refinement's points, where they determine an optimum from it, must find it within
- * 3 sigma_px.
+ * aligned from the identity, coarse to fine (HOME_REFINE_DENSE: slow shading, a soft
+ * shadow): it vouches the same way with sigma_px <= 0.3 max_sigma_px, reaches a pixel of its
+ * coarsest image (16 px at 640x360), and the refinement's points, where they determine an
+ * optimum from it, must find it within 3 sigma_px.
  *
  * Static camera: an ok motion within 2 sigma_px of the identity, or one that most regions of an
  * 8x6 grid explain worse than the identity does (each region votes with its own strongest

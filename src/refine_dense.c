@@ -373,7 +373,8 @@ static int choose(const dense_solver *s, const double *infoq, double basis[8][8]
         for (j = 0; j < s->k; j++) {
             double v = 0.0;
             for (p = 0; p < s->k; p++)
-                for (q = 0; q < s->k; q++) v += ginv[i * 8 + p] * infoq[p * 8 + q] * ginv[q * 8 + j];
+                for (q = 0; q < s->k; q++)
+                    v += ginv[i * 8 + p] * infoq[p * 8 + q] * ginv[q * 8 + j];
             core[i * 8 + j] = v;
         }
     memset(&mp, 0, sizeof mp);
@@ -418,15 +419,26 @@ static void set_model(dense_solver *s, int max_model)
     }
 }
 
+/* The estimate's matrices and the residual histogram, in the match-time scratch (the call
+ * stack of home_stab_push() stays under its bound). */
+typedef struct dense_work {
+    double info[64], basis[8][8], g[64], ginv[64], info_h[64], info_s[64], meat[64], t8[64];
+    int32_t hist[DENSE_HIST_BINS];
+} dense_work;
+typedef char home__dense_work_fits[sizeof(dense_work) <= 4 * REGION_CAPACITY * sizeof(float) ? 1
+                                                                                              : -1];
+
 int home__refine_dense(home_context *ctx, int slot, home_result *result, double *reach_px)
 {
     const home__refine_state *st = &ctx->refine;
+    dense_work *wk = (dense_work *)st->scratch;
+    double *info = wk->info, (*basis)[8] = wk->basis, *g = wk->g, *ginv = wk->ginv;
+    double *info_h = wk->info_h, *info_s = wk->info_s, *meat = wk->meat, *t8 = wk->t8;
+    int32_t *hist = wk->hist;
     dense_level lv[DENSE_LEVELS];
     dense_solver s;
     dense_fit fit;
-    int32_t hist[DENSE_HIST_BINS];
     int levels, level, it, i, j, p, converged = 0;
-    double info[64], basis[8][8], g[64], ginv[64], info_h[64], info_s[64], meat[64], t8[64];
     home__model_choice choice, sandwich;
     double resid_var, var_g;
 
@@ -499,7 +511,8 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     }
     /* two predictions: J^T W J over the residual variance (times the refinement's scale), and
      * the clustered sandwich (J^T W J) meat^-1 (J^T W J); the larger predicted error stands */
-    for (i = 0; i < 64; i++) info_h[i] = info[i] / (resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE);
+    for (i = 0; i < 64; i++)
+        info_h[i] = info[i] / (resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE);
     cluster_meat(&s, &lv[0], fit.sigma, meat);
     for (j = 0; j < s.k; j++) { /* meat^-1 info, column by column */
         double col[8], x[8];
@@ -528,7 +541,7 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         const int within = (int)(3.0 * fit.sigma * 32.0);
         int in = 0, n;
         result->refine_zncc = va > 0.0 && vb > 0.0 ? cab / sqrt(va * vb) : 0.0;
-        memset(hist, 0, sizeof hist);
+        memset(hist, 0, DENSE_HIST_BINS * sizeof *hist);
         n = pass(&s, &lv[0], 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL);
         for (i = 0; i < DENSE_HIST_BINS && i < within; i++) in += hist[i];
         result->refine_inlier_share = n ? (double)in / n : 0.0;

@@ -170,8 +170,8 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
                                   double *evidence, double *own_motion);
 
 /* refine_dense.c: frames A (slot) and B aligned from the identity with every pixel of their
- * background16 images and two 2x2 means of them: a similarity (a translation under
- * cfg.max_model), coarse to fine. 1 with result's H, model, sigma_px, refine_zncc and
+ * background16 images and two 2x2 means of them, in the most general model cfg.max_model
+ * allows, coarse to fine. 1 with result's H, model, sigma_px, refine_zncc and
  * refine_inlier_share (refine_status HOME_REFINE_DENSE) when it converged to a determined,
  * plausible motion; else 0 (result's refine_status may say why). *reach_px: a pixel of its
  * coarsest image, full-size px (how far from the identity it reaches). Uses st->sampled and
