@@ -367,7 +367,7 @@ static int choose(const dense_solver *s, const double *infoq, double basis[8][8]
                   const double *ginv, int n, home__model_choice *choice)
 {
     home__model_problem mp;
-    double core[64];
+    double core[64] = {0}; /* zeroed for cppcheck (make lint) */
     int i, j, p, q;
     for (i = 0; i < s->k; i++)
         for (j = 0; j < s->k; j++) {
