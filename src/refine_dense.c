@@ -45,6 +45,7 @@ typedef struct dense_solver {
     int k;                      /* parameters of the model fitted */
     double gen[8][8];           /* their generators: update dq -> W = I + sum q_i gen_i (the
                                    homography's entries h0..h7) */
+    int plain;                  /* gen is the identity (a homography or an affine motion) */
 } dense_solver;
 
 /* 2x2 sums of src (w x h) into dst (w/2 x h/2), rounded to `shift` bits fewer. */
@@ -111,6 +112,12 @@ static void pixel_jacobian(const dense_solver *s, const dense_level *lv, const u
     const double dy[8] = {0.0, 0.0, 0.0, u, v, 1.0, -u * v, -v * v};
     int i, e;
     for (i = 0; i < s->k; i++) {
+        if (s->plain) { /* the generators are the entries themselves: the same sums */
+            ddx[i] = dx[i];
+            ddy[i] = dy[i];
+            jr[i] = gx * ddx[i] + gy * ddy[i];
+            continue;
+        }
         ddx[i] = ddy[i] = 0.0;
         for (e = 0; e < 8; e++) {
             ddx[i] += s->gen[i][e] * dx[e];
@@ -121,8 +128,9 @@ static void pixel_jacobian(const dense_solver *s, const dense_level *lv, const u
 }
 
 /* One pass over the level's interior pixels under s->hn. mode 0: the |residual| histogram;
- * 1: the weighted sums of the gain and bias fit (sums[5]); 2: J^T W J (jtj, k x k, row stride
- * 8), J^T W r, the sums of w and w r^2, the gradient noise's sum w D^T D (noise), the
+ * 1: the weighted sums of the gain and bias fit (sums[5]); 2: the lower triangle of J^T W J
+ * (jtj, k x k, row stride 8; what the solve reads), J^T W r and the sums of w and w r^2;
+ * 3: the whole J^T W J, J^T W r, those sums, the gradient noise's sum w D^T D (noise), the
  * correlation's sums (corr[6] of w, w a, w b', w a^2, w b'^2, w a b') and J's weighted sums
  * against the gain's and the bias's derivatives (cross[16]: w J a, w J; the gain's taken as A,
  * which B matches at the optimum). Returns the pixels used. */
@@ -160,17 +168,20 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
             } else {
                 double jr[8], ddx[8], ddy[8];
                 pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
-                for (i = 0; i < s->k; i++) {
-                    cross[i] += w * jr[i] * a; /* J against the gain's and the bias's */
-                    cross[8 + i] += w * jr[i];
+                for (i = 0; i < s->k; i++) { /* mode 2: the lower triangle the solve reads */
+                    const int columns = mode == 2 ? i + 1 : s->k;
                     jtr[i] += w * jr[i] * r;
-                    for (j = 0; j < s->k; j++) {
-                        jtj[i * 8 + j] += w * jr[i] * jr[j];
-                        noise[i * 8 + j] += w * k * k * (ddx[i] * ddx[j] + ddy[i] * ddy[j]);
-                    }
+                    for (j = 0; j < columns; j++) jtj[i * 8 + j] += w * jr[i] * jr[j];
                 }
                 sums[0] += w;
                 sums[1] += w * r * r;
+                if (mode == 2) continue;
+                for (i = 0; i < s->k; i++) {
+                    cross[i] += w * jr[i] * a; /* J against the gain's and the bias's */
+                    cross[8 + i] += w * jr[i];
+                    for (j = 0; j < s->k; j++)
+                        noise[i * 8 + j] += w * k * k * (ddx[i] * ddx[j] + ddy[i] * ddy[j]);
+                }
                 b = s->alpha * b + s->beta;
                 corr[0] += w;
                 corr[1] += w * a;
@@ -298,9 +309,9 @@ typedef struct dense_fit {
 } dense_fit;
 
 /* One Gauss-Newton iteration at the level: the residuals' scale (rescale: anew, else
- * fit->sigma's), gain and bias, then the normal equations (into fit). 0 when too few pixels
- * overlap. */
-static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int rescale,
+ * fit->sigma's), gain and bias, then the normal equations (into fit; full: with the
+ * statistics of the estimate's prediction, pass() mode 3). 0 when too few pixels overlap. */
+static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int rescale, int full,
                    dense_fit *fit)
 {
     double sums[5] = {0}, det;
@@ -318,8 +329,8 @@ static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int re
     }
     {
         double pair[2] = {0.0, 0.0};
-        fit->n = pass(s, lv, 2, fit->sigma, NULL, pair, fit->jtj, fit->jtr, fit->noise, fit->corr,
-                      fit->cross);
+        fit->n = pass(s, lv, full ? 3 : 2, fit->sigma, NULL, pair, fit->jtj, fit->jtr, fit->noise,
+                      fit->corr, fit->cross);
         fit->sum_w = pair[0];
         fit->sum_wr2 = pair[1];
     }
@@ -402,10 +413,12 @@ static int choose(const dense_solver *s, const double *infoq, double basis[8][8]
 static void set_model(dense_solver *s, int max_model)
 {
     memset(s->gen, 0, sizeof s->gen);
+    s->plain = 0;
     if (max_model >= HOME_MODEL_AFFINE) {
         int e;
         s->k = max_model >= HOME_MODEL_HOMOGRAPHY ? 8 : 6;
         for (e = 0; e < s->k; e++) s->gen[e][e] = 1.0;
+        s->plain = 1;
         return;
     }
     s->gen[0][2] = 1.0; /* translation */
@@ -460,7 +473,7 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         /* the residuals' scale once per level: it changes little within one */
         for (it = 0; it < DENSE_ITERATIONS && !converged; it++) {
             double dq[8];
-            if (!iterate(&s, &lv[level], hist, it == 0, &fit) ||
+            if (!iterate(&s, &lv[level], hist, it == 0, 0, &fit) ||
                 !solve_k(fit.jtj, fit.jtr, s.k, dq) || !compose_inverse(&s, dq))
                 return 0;
             converged = step_px(&s, &lv[level], dq) < DENSE_STEP_EPS;
@@ -471,7 +484,7 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         }
     }
     /* the statistics at the estimate */
-    if (!iterate(&s, &lv[0], hist, 1, &fit)) return 0;
+    if (!iterate(&s, &lv[0], hist, 1, 1, &fit)) return 0;
     resid_var = fit.sum_w > s.k ? fit.sum_wr2 / (fit.sum_w - s.k) : fit.sum_wr2;
     var_g = DENSE_GRADIENT_NOISE_SHARE * resid_var;
     for (i = 0; i < 64; i++) info[i] = fit.jtj[i] - var_g * fit.noise[i];
