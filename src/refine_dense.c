@@ -1,7 +1,7 @@
 /* Dense direct alignment for frames too faint for template points: a few slow shading waves, a
  * soft shadow, a gentle ridge. Their gradients stay under the noise floor of every pyramid
  * level's point selection, yet summed over all pixels of a coarse image they can determine a
- * translation or a similarity well (docs/trust.md, session 20).
+ * small motion well (docs/trust.md, session 20).
  *
  * Method: inverse-compositional Gauss-Newton of the most general motion cfg.max_model allows
  * (refine.c calls it with a homography: a similarity fitted to a perspective motion is wrong
