@@ -61,18 +61,10 @@ static void halve(const uint16_t *src, int w, int h, uint16_t *dst, int shift)
     }
 }
 
-/* The level's pixel of A as B's level coordinates under s->hn: m (3x3), L^-1 N^-1 hn N L with
- * N: full-size x -> (x - c) / f and L: level x -> scale x + offset. */
+/* The level's pixel of A as B's level coordinates under s->hn: m (3x3). */
 static void level_matrix(const dense_solver *s, const dense_level *lv, double *m)
 {
-    const double c = lv->scale / s->f;
-    const double nl[9] = {c, 0.0, (lv->offset - s->cx) / s->f, 0.0, c, (lv->offset - s->cy) / s->f,
-                          0.0, 0.0, 1.0};
-    const double nl_inv[9] = {1.0 / c, 0.0, (s->cx - lv->offset) / lv->scale, 0.0, 1.0 / c,
-                              (s->cy - lv->offset) / lv->scale, 0.0, 0.0, 1.0};
-    double t[9] = {0}; /* zeroed for gcc's -fanalyzer (make lint) */
-    home__refine_mat3_mul(s->hn, nl, t);
-    home__refine_mat3_mul(nl_inv, t, m);
+    home__refine_scaled_matrix(s->f, s->cx, s->cy, s->hn, lv->scale, lv->offset, m);
 }
 
 /* Bilinear sample of B at (x, y), grey levels; 0 outside (the caller skips it). */
@@ -560,15 +552,10 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         result->refine_inlier_share = n ? (double)in / n : 0.0;
     }
     {
-        /* normalised -> pixels: H = N^-1 hn N, N: x -> (x - c) / f */
-        const double n[9] = {1.0 / s.f, 0.0, -s.cx / s.f, 0.0, 1.0 / s.f, -s.cy / s.f, 0, 0, 1};
-        const double n_inv[9] = {s.f, 0.0, s.cx, 0.0, s.f, s.cy, 0, 0, 1};
-        double hc[9], t[9] = {0}, h[9] = {0};
+        double hc[9];
         memcpy(hc, choice.p, 8 * sizeof *hc);
         hc[8] = 1.0;
-        home__refine_mat3_mul(hc, n, t);
-        home__refine_mat3_mul(n_inv, t, h);
-        for (i = 0; i < 9; i++) result->H[i] = h[i] / h[8];
+        home__refine_pixels_from_normalised(s.f, s.cx, s.cy, hc, result->H);
     }
     if (!home__homography_plausible(result->H, ctx->cfg.width, ctx->cfg.height)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;

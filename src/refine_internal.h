@@ -99,6 +99,12 @@ void home__refine_mat3_mul(const double *a, const double *b, double *out);
 int home__refine_mat3_inv(const double *m, double *out);
 void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver *s);
 void home__refine_to_normalised(const home__refine_solver *s, const double *h, double *hn);
+/* Normalised hn (u = (x - c) / f) as a homography of pixels, h8 = 1. */
+void home__refine_pixels_from_normalised(double f, double cx, double cy, const double *hn,
+                                         double *h);
+/* The same map between images whose pixel x sits at full size scale x + offset: m (3x3). */
+void home__refine_scaled_matrix(double f, double cx, double cy, const double *hn, double scale,
+                                double offset, double *m);
 void home__refine_level_matrix(const home__refine_solver *s, const double *hn, int level,
                                float *m);
 double home__refine_robust_sigma(const float *img_b, const int16_t *t, int n, double alpha,

@@ -72,27 +72,41 @@ void home__refine_to_normalised(const home__refine_solver *s, const double *h, d
     normalise9(hn);
 }
 
-static void to_pixels(const home__refine_solver *s, const double *hn, double *h)
+void home__refine_pixels_from_normalised(double f, double cx, double cy, const double *hn,
+                                         double *h)
 {
-    const double n[9] = {1 / s->f, 0, -s->cx / s->f, 0, 1 / s->f, -s->cy / s->f, 0, 0, 1};
-    const double ni[9] = {s->f, 0, s->cx, 0, s->f, s->cy, 0, 0, 1};
+    const double n[9] = {1 / f, 0, -cx / f, 0, 1 / f, -cy / f, 0, 0, 1};
+    const double ni[9] = {f, 0, cx, 0, f, cy, 0, 0, 1};
     double t[9] = {0}; /* all written by mat3_mul; zeroed for gcc's -fanalyzer (make lint) */
     home__refine_mat3_mul(ni, hn, t);
     home__refine_mat3_mul(t, n, h);
     normalise9(h);
 }
 
+static void to_pixels(const home__refine_solver *s, const double *hn, double *h)
+{
+    home__refine_pixels_from_normalised(s->f, s->cx, s->cy, hn, h);
+}
+
+void home__refine_scaled_matrix(double f, double cx, double cy, const double *hn, double scale,
+                                double offset, double *m)
+{
+    const double q[9] = {scale / f, 0, (offset - cx) / f, 0, scale / f, (offset - cy) / f, 0,
+                         0,         1};
+    const double p[9] = {f / scale, 0, (cx - offset) / scale, 0, f / scale, (cy - offset) / scale,
+                         0,         0, 1};
+    double t[9] = {0}; /* t: gcc -fanalyzer loses it through mat3_mul's loops */
+    home__refine_mat3_mul(hn, q, t);
+    home__refine_mat3_mul(p, t, m);
+}
+
 /* Matrix taking template level-l pixels to B's level-l pixels under hn. */
 void home__refine_level_matrix(const home__refine_solver *s, const double *hn, int level, float *m)
 {
-    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
-    const double q[9] = {sc / s->f, 0, (o - s->cx) / s->f, 0, sc / s->f, (o - s->cy) / s->f, 0,
-                         0,         1};
-    const double p[9] = {s->f / sc, 0, (s->cx - o) / sc, 0, s->f / sc, (s->cy - o) / sc, 0, 0, 1};
-    double t[9] = {0}, r[9]; /* t: gcc -fanalyzer loses it through mat3_mul's loops */
+    const double sc = (double)(1 << level);
+    double r[9];
     int k;
-    home__refine_mat3_mul(hn, q, t);
-    home__refine_mat3_mul(p, t, r);
+    home__refine_scaled_matrix(s->f, s->cx, s->cy, hn, sc, 0.5 * (sc - 1.0), r);
     for (k = 0; k < 9; k++) m[k] = (float)r[k];
 }
 
