@@ -325,9 +325,11 @@ typedef struct home_result {
  * refine_trust_px of the identity. Where that fails too (and nothing made the pair
  * inconsistent), with max_model a homography, every pixel of the quarter-size frames is
  * aligned from the identity, coarse to fine (HOME_REFINE_DENSE: slow shading, a soft
- * shadow): it vouches the same way with sigma_px <= 0.3 max_sigma_px, reaches a pixel of its
- * coarsest image (16 px at 640x360), and the refinement's points, where they determine an
- * optimum from it, must find it within 3 sigma_px.
+ * shadow): it vouches the same way with sigma_px <= 0.3 max_sigma_px (<= max_sigma_px when
+ * the model chosen is simpler than a homography and more than 2 sigma_px from the identity),
+ * reaches a pixel of its coarsest image (16 px at 640x360), and the refinement's points, where
+ * they determine an optimum from it, must find it within 3 sigma_px. Regions that prefer the
+ * identity to such a motion (below) make the pair inconsistent, not static.
  *
  * Static camera: an ok motion within 2 sigma_px of the identity, or one that most regions of an
  * 8x6 grid explain worse than the identity does (each region votes with its own strongest

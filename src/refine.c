@@ -61,9 +61,11 @@
                                  ones less than 0.4 */
 #define VOUCH_SHARE 0.9      /* ... and this share of its points within 3 robust sigmas (both
                                 against HOME's estimate or with none; either beside it) */
-#define DENSE_SIGMA_SHARE 0.3 /* dense alignment vouches within this share of max_sigma_px:
-                                 the tuning set's wrong dense answers (a few edges over wide
-                                 shading) predicted 0.34-0.36 px */
+#define DENSE_SIGMA_SHARE 0.3 /* a homography of the dense alignment vouches within this share
+                                 of max_sigma_px: the tuning set's wrong dense homographies (a
+                                 few edges over wide shading, or in low light) predicted
+                                 0.34-0.52 px; a simpler model that left the identity, within
+                                 max_sigma_px as any answer */
 #define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
                                      within 3 sigma_px or this */
 
@@ -165,6 +167,20 @@ static int vouches(const home_context *ctx, const home_result *r, int whole_fram
     const int consistent = r->refine_inlier_share >= VOUCH_SHARE;
     return r->sigma_px <= VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px &&
            (whole_frame ? correlated && consistent : correlated || consistent);
+}
+
+/* Does the dense alignment vouch for itself? As a refined estimate for the whole frame, but
+ * by its model: a homography's perspective rests on the frame's faint periphery, and where the
+ * alignment keeps it against simpler models its predicted error runs low; and a motion its
+ * predicted error cannot tell from the identity may be where the alignment started and stayed */
+static int dense_vouches(const home_context *ctx, const home_result *r)
+{
+    const int left_start = corner_distance(ctx, r->H, home__refine_identity) >
+                           IDENTITY_SIGMAS * r->sigma_px;
+    const double bound =
+        r->model != HOME_MODEL_HOMOGRAPHY && left_start ? 1.0 : DENSE_SIGMA_SHARE;
+    return r->refine_zncc >= VOUCH_ZNCC && r->refine_inlier_share >= VOUCH_SHARE &&
+           r->sigma_px <= bound * ctx->cfg.max_sigma_px;
 }
 
 /* home__refine_dense() on frames id_a (slot) and id_b, or its stored answer when it ran on
@@ -297,8 +313,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         const double reach = ctx->cfg.refine_trust_px * ctx->hough_scale;
         double dense_reach;
         if (dense_alignment(ctx, slot, id_a, id_b, &dense, &dense_reach) &&
-            vouches(ctx, &dense, 1) &&
-            dense.sigma_px <= DENSE_SIGMA_SHARE * ctx->cfg.max_sigma_px &&
+            dense_vouches(ctx, &dense) &&
             corner_distance(ctx, dense.H, home__refine_identity) <=
                 (dense_reach > reach ? dense_reach : reach) &&
             points_agree(ctx, slot, &dense)) {
@@ -323,9 +338,17 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         /* the plain regions, when their pixels show the identity, outweigh the textured regions
          * that prefer the motion (the background wins by area: a flat occluder in front of
          * the lens moves with the camera and covers less) */
-        if (within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
-            (home__refine_plain_regions(ctx, slot) > against &&
-             home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z)) {
+        if (!within_sigma && trial.refine_status == HOME_REFINE_DENSE &&
+            (share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
+             (home__refine_plain_regions(ctx, slot) > against &&
+              home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z))) {
+            /* the dense alignment's motion is what all pixels, the plain ones included, say;
+             * regions that prefer the identity contradict it rather than refute it */
+            trial.ok = 0;
+            trial.failure = HOME_FAIL_INCONSISTENT;
+        } else if (within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
+                   (home__refine_plain_regions(ctx, slot) > against &&
+                    home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z)) {
             memcpy(trial.H, home__refine_identity, sizeof trial.H);
             trial.model = HOME_MODEL_IDENTITY;
             trial.refine_status = HOME_REFINE_STATIC;

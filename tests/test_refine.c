@@ -416,13 +416,15 @@ void test_dense_shading(void)
         printf("     shading %d: ok %d, %s, %s, %s, error %.3f px, sigma %.3f px\n", k, res.ok,
                home_failure_name(res.failure), home_refine_status_name(res.refine_status),
                home_model_name(res.model), err, res.sigma_px);
-        if (!res.ok) continue; /* a homography may be too uncertain to vouch for */
+        if (!res.ok) continue;
         dense_ok++;
         CHECK_EQ_INT(res.refine_status, HOME_REFINE_DENSE);
         CHECK_LT(err, 0.5);
         CHECK_LT(err, 3.0 * res.sigma_px);
     }
-    CHECK(dense_ok >= 2);
+    /* all three: the first one's similarity predicts 0.36 px, more than a dense homography
+     * may (0.3 of max_sigma_px), within what any simpler model may */
+    CHECK_EQ_INT(dense_ok, 3);
     for (k = 0; k < 2; k++) {
         home_result res;
         for (y = 0; y < IMG_H; y++)
