@@ -328,7 +328,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         const double d_identity = corner_distance(ctx, trial.H, home__refine_identity);
         const int within_sigma =
             isfinite(trial.sigma_px) && d_identity <= IDENTITY_SIGMAS * trial.sigma_px;
-        int against = 0;
+        int against = 0, identity_wins;
         unsigned char still_regions[REGIONS_X * REGIONS_Y] = {0};
         double own_motion;
         share = clear_share = 0.0;
@@ -338,17 +338,15 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         /* the plain regions, when their pixels show the identity, outweigh the textured regions
          * that prefer the motion (the background wins by area: a flat occluder in front of
          * the lens moves with the camera and covers less) */
-        if (!within_sigma && trial.refine_status == HOME_REFINE_DENSE &&
-            (share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
-             (home__refine_plain_regions(ctx, slot) > against &&
-              home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z))) {
+        identity_wins = within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
+                        (home__refine_plain_regions(ctx, slot) > against &&
+                         home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z);
+        if (identity_wins && !within_sigma && trial.refine_status == HOME_REFINE_DENSE) {
             /* the dense alignment's motion is what all pixels, the plain ones included, say;
              * regions that prefer the identity contradict it rather than refute it */
             trial.ok = 0;
             trial.failure = HOME_FAIL_INCONSISTENT;
-        } else if (within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
-                   (home__refine_plain_regions(ctx, slot) > against &&
-                    home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z)) {
+        } else if (identity_wins) {
             memcpy(trial.H, home__refine_identity, sizeof trial.H);
             trial.model = HOME_MODEL_IDENTITY;
             trial.refine_status = HOME_REFINE_STATIC;

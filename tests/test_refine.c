@@ -444,8 +444,8 @@ void test_dense_shading(void)
 /* Dim frames of faint shading (gain 0.3-1, waves of 2-25 grey levels, noise 2-6, a small
  * rotation and shift): the dense alignment answers some with a translation, similarity or
  * affine motion predicting up to max_sigma_px; every answer it vouches for lies within 2 px and
- * 3 predicted errors of the truth. (Iterating on past the cap while the steps shrink made one of
- * these 1.6 px off at a predicted 0.44 px: docs/trust.md, session 21.) */
+ * 3 predicted errors of the truth (iterating on past the cap while the steps shrink made one of
+ * these 1.6 px off at a predicted 0.44 px: docs/trust.md). */
 void test_dense_dim_calibrated(void)
 {
     home_context *ctx = context(NULL);
