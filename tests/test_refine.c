@@ -381,6 +381,22 @@ void test_noisy_refinement_confirms(void)
     CHECK(low_correlation >= 2); /* the case this is about */
 }
 
+/* Four plane waves of 300-900 px, 8-25 grey levels (faint: each times 0.3-1). */
+static void shading_waves(texture *t, synth_rng *rng, int faint)
+{
+    int i;
+    memset(t, 0, sizeof *t);
+    for (i = 0; i < 4; i++) {
+        const double th = 3.14159265358979 * synth_uniform(rng);
+        const double lambda = 300.0 + 600.0 * synth_uniform(rng);
+        t->kx[i] = 2 * 3.14159265358979 / lambda * cos(th);
+        t->ky[i] = 2 * 3.14159265358979 / lambda * sin(th);
+        t->phase[i] = 6.28318530717959 * synth_uniform(rng);
+        t->amp[i] = 8.0 + 17.0 * synth_uniform(rng);
+        if (faint) t->amp[i] *= 0.3 + 0.7 * synth_uniform(rng);
+    }
+}
+
 /* Frames of slow shading only (four plane waves of 300-900 px, camera noise 2.5): no edge for
  * HOME, no gradient above the refinement's noise floor, yet all the pixels of the quarter-size
  * images fix a small camera motion (HOME_REFINE_DENSE). A linear ramp's shift is a bias change,
@@ -396,17 +412,8 @@ void test_dense_shading(void)
         home_result res;
         double h[9], err;
         const double angle = (k - 1) * 0.003;
-        int i;
-        memset(&t, 0, sizeof t);
         synth_seed(&rng, 2000 + k);
-        for (i = 0; i < 4; i++) {
-            const double th = 3.14159265358979 * synth_uniform(&rng);
-            const double lambda = 300.0 + 600.0 * synth_uniform(&rng);
-            t.kx[i] = 2 * 3.14159265358979 / lambda * cos(th);
-            t.ky[i] = 2 * 3.14159265358979 / lambda * sin(th);
-            t.phase[i] = 6.28318530717959 * synth_uniform(&rng);
-            t.amp[i] = 8.0 + 17.0 * synth_uniform(&rng);
-        }
+        shading_waves(&t, &rng, 0);
         h[0] = cos(angle); h[1] = -sin(angle); h[3] = sin(angle); h[4] = cos(angle);
         h[2] = 2.5 - k; h[5] = -1.5 + 1.5 * k; h[6] = h[7] = 0.0; h[8] = 1.0;
         render_texture(&t, identity, 1.0, 2.5, 2100 + 2 * k, img_a);
@@ -456,17 +463,8 @@ void test_dense_dim_calibrated(void)
         synth_rng rng;
         home_result res;
         double h[9], err, angle, gain, noise;
-        int i;
-        memset(&t, 0, sizeof t);
         synth_seed(&rng, 2100 + k);
-        for (i = 0; i < 4; i++) {
-            const double th = 3.14159265358979 * synth_uniform(&rng);
-            const double lambda = 300.0 + 600.0 * synth_uniform(&rng);
-            t.kx[i] = 2 * 3.14159265358979 / lambda * cos(th);
-            t.ky[i] = 2 * 3.14159265358979 / lambda * sin(th);
-            t.phase[i] = 6.28318530717959 * synth_uniform(&rng);
-            t.amp[i] = (8.0 + 17.0 * synth_uniform(&rng)) * (0.3 + 0.7 * synth_uniform(&rng));
-        }
+        shading_waves(&t, &rng, 1);
         angle = 0.004 * (synth_uniform(&rng) - 0.5);
         h[0] = cos(angle); h[1] = -sin(angle); h[3] = sin(angle); h[4] = cos(angle);
         h[2] = 4.0 * (synth_uniform(&rng) - 0.5);
