@@ -140,7 +140,7 @@ typedef struct app {
 static const char *status_name(int s)
 {
     static const char *names[] = {"first", "ok", "failed", "implausible", "cut",
-                                  "still", "restored", "partial"};
+                                  "still", "restored", "partial", "bridged"};
     return s >= 0 && s < (int)(sizeof names / sizeof names[0]) ? names[s] : "?";
 }
 

@@ -17,7 +17,10 @@
  * diagonal (a knocked tripod). A moving camera keeps moving: a motion HOME refused because the
  * plain background stood still (HOME_REFINE_STILL_BACKGROUND: a hand at the lens) is taken when
  * at least 2 of the 8 frames before it and up to 2 after it register a motion and none the
- * identity (a tripod shot's objects over fog are refused alike, among still frames).
+ * identity (a tripod shot's objects over fog are refused alike, among still frames). Frames
+ * held after frames that register a moving camera are bridged when a later frame (up to 3
+ * later) registers to the last frame before the hold: they take the motion that closes the
+ * gap, so the path does not keep the missed motion as an offset.
  *
  * Scene cuts: a frame that cannot be registered to its predecessor and whose coarse luma (16x16
  * cell means) correlates below 0.5 with the predecessor's at every shift up to max_shift, once
@@ -129,9 +132,13 @@ enum home_stab_motion_status {
                                    stood still, taken because the frames around it register a
                                    moving camera (a plain part moving with the camera: a hand at
                                    the lens, blocks an encoder left unchanged) */
-    HOME_STAB_MOTION_PARTIAL    /* too little structure for a whole motion (a horizon in fog):
+    HOME_STAB_MOTION_PARTIAL,   /* too little structure for a whole motion (a horizon in fog):
                                    the shift the frames determine (across the horizon), none
                                    along it and no rotation */
+    HOME_STAB_MOTION_BRIDGED    /* held among frames of a moving camera, then given its share
+                                   of the motion a later frame (up to 3 later) registers against
+                                   the last frame before the hold: the path after the hold goes
+                                   on where the camera is, not offset by the missed motion */
 };
 
 /* A similarity about the image centre c: p -> exp(log_scale) R(angle) (p - c) + c + (tx, ty). */

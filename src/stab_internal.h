@@ -25,6 +25,9 @@ void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t s
  * up to 2 frames late. */
 #define HOME__STAB_MIN_RING 11
 
+/* A hold is bridged by a frame at most this many frames after the last frame before it. */
+#define HOME__STAB_BRIDGE 3
+
 /* One frame of path history. Path components are normalised to pixels (angle and log scale
  * times the half diagonal) so that one filter covariance serves all four of them. */
 typedef struct stab_slot {
@@ -51,6 +54,8 @@ struct home_stab {
     home_stab_config cfg;
     home_context *home;
     home_features *feat[2];       /* [0] previous frame, [1] current: swapped by pointer */
+    home_features *anchor;        /* the last frame before a hold (anchor_frame; -1: none) */
+    long anchor_frame;
     uint8_t *small;               /* downscaled luma */
     int small_w, small_h;
     /* HOME's box downscale of planar rows (its backend's): the same rounding as the reference
@@ -93,6 +98,11 @@ home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last);
 long home__stab_still_delay(const home_stab *st);
 void home__stab_settle_still(home_stab *st, long t, long newest);
 void home__stab_settle_restored(home_stab *st, long t, long newest);
+int home__stab_camera_moves(const home_stab *st, long t);
+/* Frame t's motion becomes m (status, weight): the path from t on is composed and filtered
+ * again up to newest. */
+void home__stab_retake_motion(home_stab *st, long t, long newest, const home_stab_sim *m,
+                              int status, double weight);
 
 /* stab_cut.c */
 void home__stab_thumbnail(const uint8_t *luma, ptrdiff_t stride, int w, int h, float *thumb);

@@ -71,8 +71,8 @@ static int is_lone(const home_stab *st, long t, long newest)
 
 /* Frame t's motion becomes m (status, weight): the path from t on is composed and filtered
  * again up to newest. */
-static void retake_motion(home_stab *st, long t, long newest, const home_stab_sim *m, int status,
-                          double weight)
+void home__stab_retake_motion(home_stab *st, long t, long newest, const home_stab_sim *m,
+                              int status, double weight)
 {
     const long first = st->first, lookahead = st->cfg.lookahead;
     stab_slot *s = slot_of(st, t);
@@ -144,7 +144,22 @@ void home__stab_settle_still(home_stab *st, long t, long newest)
     if (t <= st->first || t < st->emitted ||
         !(is_lone(st, t, newest) || background_refutes(st, t, newest)))
         return;
-    retake_motion(st, t, newest, &none, HOME_STAB_MOTION_STILL, slot_of(st, t)->weight);
+    home__stab_retake_motion(st, t, newest, &none, HOME_STAB_MOTION_STILL, slot_of(st, t)->weight);
+}
+
+/* Do the frames up to t (RESTORE_BEFORE of them, this segment's) register a moving camera: at
+ * least RESTORE_MIN motions and none still? */
+int home__stab_camera_moves(const home_stab *st, long t)
+{
+    long i;
+    int still = 0, moved = 0;
+    for (i = t - RESTORE_BEFORE + 1; i <= t; i++)
+        if (i > st->first && slot_of(st, i)->frame == i) {
+            const stab_slot *n = slot_of(st, i);
+            still += n->registered_still || n->status == HOME_STAB_MOTION_STILL;
+            moved += n->status == HOME_STAB_MOTION_OK && !n->registered_still;
+        }
+    return moved >= RESTORE_MIN && !still;
 }
 
 /* A held frame t with a refused motion among moving neighbours takes that motion. Restored
@@ -165,6 +180,6 @@ void home__stab_settle_restored(home_stab *st, long t, long newest)
             moved += n->status == HOME_STAB_MOTION_OK && !n->registered_still;
         }
     if (moved >= RESTORE_MIN && !still)
-        retake_motion(st, t, newest, &s->candidate, HOME_STAB_MOTION_RESTORED,
+        home__stab_retake_motion(st, t, newest, &s->candidate, HOME_STAB_MOTION_RESTORED,
                       s->candidate_weight);
 }

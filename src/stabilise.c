@@ -155,7 +155,7 @@ static void plan(const home_stab_config *cfg, const home_config *h, stab_layout 
     l->stab = at; at = align_up(at + sizeof(home_stab));
     l->home_bytes = home_arena_size(h);
     l->home = at; at = align_up(at + l->home_bytes);
-    l->feat = at; at = align_up(at + 2 * sizeof(home_features));
+    l->feat = at; at = align_up(at + 3 * sizeof(home_features)); /* previous, current, anchor */
     l->small = at; at = align_up(at + (size_t)h->width * (size_t)h->height);
     l->ring = at; at = align_up(at + (size_t)ring_length(cfg) * sizeof(stab_slot));
     l->total = at;
@@ -196,7 +196,9 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     if (status != HOME_OK) return status;
     st->feat[0] = (home_features *)(void *)(base + l.feat);
     st->feat[1] = st->feat[0] + 1;
-    memset(st->feat[0], 0, 2 * sizeof(home_features));
+    st->anchor = st->feat[0] + 2;
+    st->anchor_frame = -1;
+    memset(st->feat[0], 0, 3 * sizeof(home_features));
     {
         const home__kernels *k = home__kernels_for(h.simd);
         st->box_down = (k ? k : &home__kernels_scalar)->box_down;
@@ -437,6 +439,63 @@ static int check_stab(const home_stab *st, const home_stab_output *out)
     return st->magic == STAB_MAGIC ? HOME_OK : HOME_E_STATE;
 }
 
+/* A frame held with no refused motion the restore could take. */
+static int held_for_good(const stab_slot *s)
+{
+    return (s->status == HOME_STAB_MOTION_FAILED && !s->has_candidate) ||
+           s->status == HOME_STAB_MOTION_IMPLAUSIBLE;
+}
+
+/* Frame n (features in feat[0]) against the anchor, the last frame a before a hold among
+ * frames that register a moving camera (home__stab_camera_moves()): when HOME
+ * registers it there, the held frames in (a, n] take the motion that makes the path from a to
+ * n that registration, and the hold is over. Where all of (a, n] was held, each frame takes an
+ * equal share (the last one what closes the gap exactly); else the last held frame takes all.
+ * The anchor's refinement snapshot is gone, so this is HOME's own estimate, weighted by its
+ * sigma. */
+static int bridge(home_stab *st, long n)
+{
+    home_result reg;
+    home_stab_sim m_an, target, post, m_k;
+    double weight;
+    long a = st->anchor_frame, k, i;
+    int all_held = 1;
+    /* not across a cut, nor over a frame the restore may still take (its motion would count
+     * twice) */
+    for (i = a + 1; i <= n; i++) {
+        const stab_slot *s = slot_of(st, i);
+        if (s->status == HOME_STAB_MOTION_CUT ||
+            (s->status == HOME_STAB_MOTION_FAILED && s->has_candidate))
+            return 0;
+        all_held &= held_for_good(s);
+    }
+    for (k = n; k > a && !held_for_good(slot_of(st, k)); k--)
+        ;
+    if (k <= a || (all_held ? a + 1 : k) < st->emitted) return 0;
+    if (home_match(st->home, st->anchor, st->feat[0], &reg) != HOME_OK || !reg.ok ||
+        !plausible_motion(st, &reg, &m_an, &weight))
+        return 0;
+    if (all_held) {
+        const home_stab_sim share = home__stab_sim_scaled(&m_an, 1.0 / (double)(n - a));
+        for (i = a + 1; i < n; i++)
+            home__stab_retake_motion(st, i, n, &share, HOME_STAB_MOTION_BRIDGED, weight);
+    }
+    /* raw_n' = m_an raw_a, and raw_n' = post m_k raw_(k-1), post the motions after k */
+    target = home__stab_sim_compose(&m_an, &slot_of(st, a)->raw);
+    {
+        const home_stab_sim inv_k = home__stab_sim_inverse(&slot_of(st, k)->raw);
+        post = home__stab_sim_compose(&slot_of(st, n)->raw, &inv_k);
+    }
+    {
+        const home_stab_sim inv_post = home__stab_sim_inverse(&post);
+        const home_stab_sim inv_before = home__stab_sim_inverse(&slot_of(st, k - 1)->raw);
+        const home_stab_sim rest = home__stab_sim_compose(&target, &inv_before);
+        m_k = home__stab_sim_compose(&inv_post, &rest);
+    }
+    home__stab_retake_motion(st, k, n, &m_k, HOME_STAB_MOTION_BRIDGED, weight);
+    return 1;
+}
+
 int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output *out)
 {
     const uint8_t *luma;
@@ -520,6 +579,18 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     }
     st->pushed = n + 1;
     st->tail = 0;
+    /* a hold: the last frame before it stays as the anchor; a later frame may bridge it */
+    if (st->anchor_frame >= 0 &&
+        (slot->status == HOME_STAB_MOTION_CUT || n - st->anchor_frame > HOME__STAB_BRIDGE ||
+         bridge(st, n)))
+        st->anchor_frame = -1;
+    if (st->anchor_frame < 0 && n > st->first && held_for_good(slot) &&
+        home__stab_camera_moves(st, n - 1)) { /* a tripod's holds stay holds */
+        swap = st->anchor; /* feat[1] holds frame n - 1's features until the next extract */
+        st->anchor = st->feat[1];
+        st->feat[1] = swap;
+        st->anchor_frame = n - 1;
+    }
     home__stab_settle_still(st, n - home__stab_still_delay(st), n);
     home__stab_settle_restored(st, n - home__stab_still_delay(st), n);
     if (n - st->first == st->cfg.lookahead) home__stab_refilter_mirrored_start(st, st->first, n);

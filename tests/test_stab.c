@@ -952,6 +952,53 @@ static void test_no_cut_on_exposure_or_fade(void)
     CHECK_EQ_INT(count_cuts(status, CLIP_FRAMES), 0);
 }
 
+/* Push a grey frame (w x h luma, its I420 chroma planes after it set to 128; NULL: flush) and
+ * keep the path and status of the frame reported. */
+static int feed(home_stab *st, uint8_t *frame, int w, int h, home_stab_sim *raw, int *status)
+{
+    home_stab_image im;
+    home_stab_output o;
+    int rc;
+    if (!frame) {
+        rc = home_stab_flush(st, &o);
+    } else {
+        memset(frame + w * h, 128, (size_t)(w * h / 2));
+        memset(&im, 0, sizeof im);
+        im.format = HOME_STAB_I420;
+        im.width = w;
+        im.height = h;
+        im.plane[0] = frame;
+        im.plane[1] = frame + w * h;
+        im.plane[2] = frame + w * h + w * h / 4;
+        im.stride[0] = w;
+        im.stride[1] = im.stride[2] = w / 2;
+        rc = home_stab_push(st, &im, &o);
+    }
+    if (rc == HOME_OK && o.ready) {
+        raw[o.frame] = o.raw;
+        status[o.frame] = o.motion_status;
+    }
+    return rc;
+}
+
+/* Corner error of the path from frame i to frame j (raw(j) raw(i)^-1) against the camera's. */
+static double path_error(const home_stab_sim *raw, double (*g)[9], int i, int j, int w, int h)
+{
+    double a[9], b[9], inv[9], got[9], want[9];
+    int c, r, k;
+    home_stab_sim_to_matrix(&raw[j], w, h, a);
+    home_stab_sim_to_matrix(&raw[i], w, h, b);
+    synth_invert(b, inv);
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++)
+            for (got[3 * r + c] = 0, k = 0; k < 3; k++) got[3 * r + c] += a[3 * r + k] * inv[3 * k + c];
+    synth_invert(g[i], inv);
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++)
+            for (want[3 * r + c] = 0, k = 0; k < 3; k++) want[3 * r + c] += g[j][3 * r + k] * inv[3 * k + c];
+    return synth_corner_error(got, want, w, h);
+}
+
 /* A dark blurred hand at the lens (bench/stab/realworld.py's, smaller: frames 20..51 over the
  * lower left), 640x360, camera shaking by shake_px (0: on a tripod). Counts the frames restored
  * and held, and the worst corner error of a restored motion against the camera's. */
@@ -965,8 +1012,6 @@ static int hand_at_lens(double shake_px, int *held, double *worst)
     const stab_clip_motion motion = {FRAMES, shake_px, shake_px / 10.0, shake_px * 13.0, 5};
     home_stab_config cfg;
     home_stab *st = NULL;
-    home_stab_output o;
-    home_stab_image im;
     int t, i, restored = 0;
     home_stab_default_config(&cfg, HW, HH);
     cfg.lookahead = LOOKAHEAD;
@@ -989,45 +1034,73 @@ static int hand_at_lens(double shake_px, int *held, double *worst)
                 const double m = 0.5 - 0.5 * tanh((sqrt(dx * dx + dy * dy) - 1.0) * 0.35 * HH / 25.0);
                 frame[i] = (uint8_t)(m * (22.0 + 10.0 * (i / HW) / HH) + (1.0 - m) * frame[i] + 0.5);
             }
-            memset(frame + HW * HH, 128, HW * HH / 2);
-            memset(&im, 0, sizeof im);
-            im.format = HOME_STAB_I420;
-            im.width = HW;
-            im.height = HH;
-            im.plane[0] = frame;
-            im.plane[1] = frame + HW * HH;
-            im.plane[2] = frame + HW * HH + HW * HH / 4;
-            im.stride[0] = HW;
-            im.stride[1] = im.stride[2] = HW / 2;
-            CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_OK);
-        } else {
-            CHECK_EQ_INT(home_stab_flush(st, &o), HOME_OK);
         }
-        if (!o.ready) continue;
-        raw[o.frame] = o.raw;
-        status[o.frame] = o.motion_status;
+        CHECK_EQ_INT(feed(st, t < FRAMES ? frame : NULL, HW, HH, raw, status), HOME_OK);
     }
     for (t = 1; t < FRAMES; t++) {
-        /* the motion taken against the camera's: corner error of raw(t) raw(t-1)^-1 */
-        double a[9], b[9], inv[9], got[9], want[9], err = 0.0;
-        int c, r, k;
+        /* the motion taken against the camera's */
+        double err;
         if (status[t] == HOME_STAB_MOTION_FAILED) ++*held;
         if (status[t] != HOME_STAB_MOTION_RESTORED) continue;
         restored++;
-        home_stab_sim_to_matrix(&raw[t], HW, HH, a);
-        home_stab_sim_to_matrix(&raw[t - 1], HW, HH, b);
-        synth_invert(b, inv);
-        for (r = 0; r < 3; r++)
-            for (c = 0; c < 3; c++)
-                for (got[3 * r + c] = 0, k = 0; k < 3; k++) got[3 * r + c] += a[3 * r + k] * inv[3 * k + c];
-        synth_invert(g[t - 1], inv);
-        for (r = 0; r < 3; r++)
-            for (c = 0; c < 3; c++)
-                for (want[3 * r + c] = 0, k = 0; k < 3; k++) want[3 * r + c] += g[t][3 * r + k] * inv[3 * k + c];
-        err = synth_corner_error(got, want, HW, HH);
+        err = path_error(raw, g, t - 1, t, HW, HH);
         if (err > *worst) *worst = err;
     }
     return restored;
+}
+
+/* Two flat frames (20, 21) in a shaking clip: no registration to or from them, so frames 20-22
+ * are held. Frame 22 registers to frame 19, the last before the hold, and the three share the
+ * motion that closes the gap (bridged): the path from 19 to 22 is the camera's, not short of
+ * the three frames' shake (without the bridge it is the identity). A longer hold is not
+ * bridged. */
+static void test_hold_bridged(void)
+{
+    enum { HW = 640, HH = 360, FRAMES = 40, LOOKAHEAD = 8 };
+    static uint8_t frame[HW * HH * 3 / 2];
+    static double g[FRAMES][9];
+    static home_stab_sim raw[FRAMES];
+    static int status[FRAMES];
+    const stab_clip_motion motion = {FRAMES, 4.0, 0.4, 52.0, 5};
+    int flat_last;
+    for (flat_last = 21; flat_last <= 25; flat_last += 4) {
+        home_stab_config cfg;
+        home_stab *st = NULL;
+        double err, shake;
+        int t;
+        home_stab_default_config(&cfg, HW, HH);
+        cfg.lookahead = LOOKAHEAD;
+        CHECK_EQ_INT(home_stab_init(&st, &cfg, ALIGNED_ARENA(arena.bytes),
+                                    ALIGNED_BYTES(arena.bytes), NULL), HOME_OK);
+        if (!st) return;
+        for (t = 0; t < FRAMES + LOOKAHEAD; t++) {
+            if (t < FRAMES) {
+                double intent[9];
+                stab_clip_camera(&motion, t, HW, HH, g[t], intent);
+                synth_render(SYNTH_STRUCTURED, 1, g[t], 2.0, (uint64_t)t + 1, frame, HW, HH, HW);
+                if (t >= 20 && t <= flat_last) memset(frame, 100, HW * HH);
+            }
+            CHECK_EQ_INT(feed(st, t < FRAMES ? frame : NULL, HW, HH, raw, status), HOME_OK);
+        }
+        err = path_error(raw, g, 19, flat_last + 1, HW, HH);
+        {
+            const home_stab_sim none = {0, 0, 0, 0};
+            home_stab_sim still[FRAMES];
+            for (t = 0; t < FRAMES; t++) still[t] = none;
+            shake = path_error(still, g, 19, flat_last + 1, HW, HH);
+        }
+        printf("    frames 20-%d flat: frame %d %s, path 19 -> %d %.2f px off (the camera "
+               "moved %.2f px)\n", flat_last, flat_last + 1,
+               status[flat_last + 1] == HOME_STAB_MOTION_BRIDGED ? "bridged" : "held",
+               flat_last + 1, err, shake);
+        if (flat_last == 21) {
+            for (t = 20; t <= 22; t++) CHECK_EQ_INT(status[t], HOME_STAB_MOTION_BRIDGED);
+            CHECK_LT(err, 1.5); /* HOME's lines alone: the anchor's refinement snapshot is gone */
+            CHECK(shake > 10.0); /* the hold would have left that much */
+        } else {
+            CHECK(status[flat_last + 1] != HOME_STAB_MOTION_BRIDGED);
+        }
+    }
 }
 
 /* With the camera shaking, HOME refuses motions the hand's plain area does not show; where the
@@ -1052,7 +1125,7 @@ static void test_hand_at_lens_followed(void)
     X(warp_formats_agree) X(warp_bands_match_whole) X(jitter_reduced_causal) X(horizon_in_fog_partial) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
     X(deterministic) X(static_camera_moving_object) X(static_fog_with_objects) X(cut_restarts_path) X(caller_cut) \
-    X(no_cut_on_exposure_or_fade) X(crop_after_the_fact) X(hand_at_lens_followed)
+    X(no_cut_on_exposure_or_fade) X(crop_after_the_fact) X(hand_at_lens_followed) X(hold_bridged)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
 

@@ -695,7 +695,7 @@ def registration(stab, clip_y4m, truth, work, extra):
     for k in range(1, min(len(rows), len(g))):
         if k in skip or rows[k]["status"] in ("first", "cut"):
             continue
-        if rows[k]["status"] not in ("ok", "still", "restored"):
+        if rows[k]["status"] not in ("ok", "still", "restored", "bridged"):
             failed += 1
             continue
         path = [camera(float(rows[j]["raw_tx"]), float(rows[j]["raw_ty"]),

@@ -119,7 +119,7 @@ static GstStaticPadTemplate src_template =
 static const char *motion_status_name(int status)
 {
     static const char *names[] = {"first", "ok",    "failed",  "implausible",
-                                  "cut",   "still", "restored", "partial"};
+                                  "cut",   "still", "restored", "partial", "bridged"};
     return status >= 0 && status < (int)G_N_ELEMENTS(names) ? names[status] : "unknown";
 }
 

@@ -78,7 +78,7 @@ static void check_output(const home_stab_output *out)
     for (k = 0; k < 9; k++) FZ_CHECK(isfinite(out->warp[k]));
     FZ_CHECK(out->correction_used >= 0.0 && out->correction_used <= 1.0);
     FZ_CHECK(out->motion_status >= HOME_STAB_MOTION_FIRST &&
-             out->motion_status <= HOME_STAB_MOTION_PARTIAL);
+             out->motion_status <= HOME_STAB_MOTION_BRIDGED);
     FZ_CHECK(isfinite(out->raw.tx) && isfinite(out->raw.ty) && isfinite(out->smooth.angle));
 }
 
