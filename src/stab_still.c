@@ -147,19 +147,25 @@ void home__stab_settle_still(home_stab *st, long t, long newest)
     home__stab_retake_motion(st, t, newest, &none, HOME_STAB_MOTION_STILL, slot_of(st, t)->weight);
 }
 
-/* Do the frames up to t (RESTORE_BEFORE of them, this segment's) register a moving camera: at
- * least RESTORE_MIN motions and none still? */
-int home__stab_camera_moves(const home_stab *st, long t)
+/* Do the frames from..to of this segment, but skip, register a moving camera: at least
+ * RESTORE_MIN motions and none still? */
+static int moving_camera(const home_stab *st, long from, long to, long skip)
 {
     long i;
     int still = 0, moved = 0;
-    for (i = t - RESTORE_BEFORE + 1; i <= t; i++)
-        if (i > st->first && slot_of(st, i)->frame == i) {
+    for (i = from; i <= to; i++)
+        if (i != skip && i > st->first && slot_of(st, i)->frame == i) {
             const stab_slot *n = slot_of(st, i);
             still += n->registered_still || n->status == HOME_STAB_MOTION_STILL;
             moved += n->status == HOME_STAB_MOTION_OK && !n->registered_still;
         }
     return moved >= RESTORE_MIN && !still;
+}
+
+/* Do the RESTORE_BEFORE frames up to t register a moving camera? */
+int home__stab_camera_moves(const home_stab *st, long t)
+{
+    return moving_camera(st, t - RESTORE_BEFORE + 1, t, -1);
 }
 
 /* A held frame t with a refused motion among moving neighbours takes that motion. Restored
@@ -168,18 +174,10 @@ void home__stab_settle_restored(home_stab *st, long t, long newest)
 {
     const long after = newest - t < STILL_AFTER ? newest - t : STILL_AFTER;
     const stab_slot *s;
-    long i;
-    int still = 0, moved = 0;
     if (t <= st->first || t < st->emitted) return;
     s = slot_of(st, t);
     if (s->frame != t || s->status != HOME_STAB_MOTION_FAILED || !s->has_candidate) return;
-    for (i = t - RESTORE_BEFORE; i <= t + after; i++)
-        if (i != t && i > st->first && slot_of(st, i)->frame == i) {
-            const stab_slot *n = slot_of(st, i);
-            still += n->registered_still || n->status == HOME_STAB_MOTION_STILL;
-            moved += n->status == HOME_STAB_MOTION_OK && !n->registered_still;
-        }
-    if (moved >= RESTORE_MIN && !still)
+    if (moving_camera(st, t - RESTORE_BEFORE, t + after, t))
         home__stab_retake_motion(st, t, newest, &s->candidate, HOME_STAB_MOTION_RESTORED,
-                      s->candidate_weight);
+                                 s->candidate_weight);
 }
