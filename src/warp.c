@@ -80,24 +80,60 @@ static int check_image(const home_stab_image *im)
 
 int home__stab_check_image(const home_stab_image *im) { return check_image(im); }
 
-/* One output row (home__warp_row_c's contract) by the table k: its body kernel takes the planar
- * rows inside the source up to a multiple of its block, the reference the rest. */
+/* floor(a / b) for b > 0 */
+static int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+/* The samples i of a row whose coordinate c0 + i d lies in [0, c_max): [*lo, *hi) (an affine
+ * row enters and leaves the source once), intersected with what the two bounds hold. */
+static void inside_span(int64_t c0, int64_t d, int64_t c_max, int64_t *lo, int64_t *hi)
+{
+    int64_t a, b;
+    if (d == 0) {
+        if (c0 < 0 || c0 >= c_max) *hi = *lo;
+        return;
+    }
+    if (d > 0) {
+        a = c0 >= 0 ? 0 : floor_div(-c0 + d - 1, d); /* first i with c >= 0 */
+        b = floor_div(c_max - 1 - c0, d) + 1;        /* past the last i with c < c_max */
+    } else {
+        a = c0 < c_max ? 0 : floor_div(c0 - c_max, -d) + 1;
+        b = floor_div(c0, -d) + 1;
+    }
+    if (a > *lo) *lo = a;
+    if (b < *hi) *hi = b;
+    if (*hi < *lo) *hi = *lo;
+}
+
+/* One output row (home__warp_row_c's contract) by the table k: its body kernel takes the part
+ * of a planar row inside the source up to a multiple of its block, the reference the rest (a
+ * crop that reaches the frame's last column or row, or the identity, still warps in SIMD). */
 void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t stride, int step,
                     int w, int h, int32_t x0, int32_t y0, int32_t dx, int32_t dy, uint8_t *dst,
                     int dst_step, int n)
 {
-    int body;
-    if (step != 1 || dst_step != 1 || !home__warp_row_inside(w, h, x0, y0, dx, dy, n)) {
+    int64_t lo = 0, hi = n;
+    int first, body;
+    if (step != 1 || dst_step != 1) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
-    body = n & ~(k->block - 1); /* a power of two: no division (armv7 has none) */
-    if (body > 0) k->warp_row(src, stride, w, x0, y0, dx, dy, dst, body);
-    if (body < n) /* inside too: the reference's fast path */
+    inside_span(x0, dx, (int64_t)(w - 1) << HOME__WARP_FRAC_BITS, &lo, &hi);
+    inside_span(y0, dy, (int64_t)(h - 1) << HOME__WARP_FRAC_BITS, &lo, &hi);
+    first = (int)lo;
+    body = (int)(hi - lo) & ~(k->block - 1); /* a power of two: no division (armv7 has none) */
+    if (body <= 0) {
+        home__warp_row_c(src, stride, 1, w, h, x0, y0, dx, dy, dst, 1, n);
+        return;
+    }
+    if (first > 0) home__warp_row_c(src, stride, 1, w, h, x0, y0, dx, dy, dst, 1, first);
+    k->warp_row(src, stride, w, (int32_t)((uint32_t)x0 + (uint32_t)first * (uint32_t)dx),
+                (int32_t)((uint32_t)y0 + (uint32_t)first * (uint32_t)dy), dx, dy, dst + first,
+                body);
+    if (first + body < n)
         home__warp_row_c(src, stride, 1, w, h,
-                         (int32_t)((uint32_t)x0 + (uint32_t)body * (uint32_t)dx),
-                         (int32_t)((uint32_t)y0 + (uint32_t)body * (uint32_t)dy), dx, dy,
-                         dst + body, 1, n - body);
+                         (int32_t)((uint32_t)x0 + (uint32_t)(first + body) * (uint32_t)dx),
+                         (int32_t)((uint32_t)y0 + (uint32_t)(first + body) * (uint32_t)dy), dx,
+                         dy, dst + first + body, 1, n - first - body);
 }
 
 static int32_t to_q16(double v) { return (int32_t)floor(v * 65536.0 + 0.5); }
