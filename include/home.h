@@ -329,7 +329,11 @@ typedef struct home_result {
  * the model chosen is simpler than a homography and more than 2 sigma_px from the identity),
  * reaches a pixel of its coarsest image (16 px at 640x360), and the refinement's points, where
  * they determine an optimum from it, must find it within 3 sigma_px. Regions that prefer the
- * identity to such a motion (below) make the pair inconsistent, not static.
+ * identity to such a motion (below) make the pair inconsistent, not static. Where that gives
+ * no answer either, HOME's estimate failed only as too uncertain and an agreeing refinement
+ * that could not vouch confirm each other when the refined H predicts sigma_px <=
+ * max_sigma_px, refine_zncc >= 0.9 and refine_inlier_share >= 0.97, and the two lie within 2
+ * of their combined predicted errors (sqrt of the sum of both sigma_px squared): the refined H.
  *
  * Static camera: an ok motion within 2 sigma_px of the identity, or one that most regions of an
  * 8x6 grid explain worse than the identity does (each region votes with its own strongest

@@ -381,6 +381,50 @@ void test_noisy_refinement_confirms(void)
     CHECK(low_correlation >= 2); /* the case this is about */
 }
 
+/* Dim structured frames (a sixth of the contrast over a dark floor, noise 3): HOME's line fit
+ * is only too uncertain (sigma_px above max_sigma_px), and the refinement next to it predicts
+ * more than the 0.4 max_sigma_px it would need to vouch alone. Two measurements from different
+ * evidence agreeing within their combined error, nearly every refined point consistent, are
+ * the answer (the dense alignment, tried first, has none here); every ok answer is within
+ * 3 predicted errors. */
+void test_uncertain_lines_confirmed(void)
+{
+    home_context *ctx = context(NULL);
+    int k, i, ok = 0, confirmed = 0;
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 8; k++) {
+        double h[9], err;
+        home_result res;
+        synth_rng rng;
+        synth_seed(&rng, 3000 + k);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 8.0, h);
+        synth_render(SYNTH_STRUCTURED, (uint32_t)(3000 + k), identity, 0.0, 1, img_a, IMG_W, IMG_H, IMG_W);
+        synth_render(SYNTH_STRUCTURED, (uint32_t)(3000 + k), h, 0.0, 2, img_b, IMG_W, IMG_H, IMG_W);
+        for (i = 0; i < 2; i++) {
+            uint8_t *im = i ? img_b : img_a;
+            int j;
+            synth_seed(&rng, 10 + 2 * k + i);
+            for (j = 0; j < IMG_W * IMG_H; j++) {
+                const double v = 40.0 + 0.15 * im[j] + 3.0 * synth_gauss(&rng);
+                im[j] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : v + 0.5);
+            }
+        }
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
+        printf("     pair %d: ok %d, %s, %s, %d inliers, share %.3f, error %.3f px, sigma %.3f px\n",
+               k, res.ok, home_failure_name(res.failure),
+               home_refine_status_name(res.refine_status), res.inliers, res.refine_inlier_share,
+               err, res.sigma_px);
+        if (!res.ok) continue;
+        ok++;
+        confirmed += res.refine_status == HOME_REFINE_ACCEPTED && res.sigma_px > 0.4;
+        CHECK_LT(err, 1.0);
+        CHECK_LT(err, 3.0 * res.sigma_px);
+    }
+    CHECK(confirmed >= 2); /* the case this is about */
+    CHECK(ok >= 5);
+}
+
 /* Four plane waves of 300-900 px, 8-25 grey levels (faint: each times 0.3-1). */
 static void shading_waves(texture *t, synth_rng *rng, int faint)
 {
@@ -776,7 +820,7 @@ void test_refine_bad_inputs(void)
 
 #define TEST_LIST(X) \
     X(kernels_match_references) X(arena_and_config) X(region_grid_exact) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
-    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(dense_shading) X(dense_dim_calibrated) \
+    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_dim_calibrated) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
 
