@@ -45,7 +45,7 @@ Metrics (luma):
 Sets: --set tuning | test | all (thresholds of the library are tuned on tuning only).
 Usage: python3 bench/stab/realworld.py [--set all] [--quick] [--clips NAME,...] [--jobs 2]
          [--build build] [--cache DIR] [--stab-args "..."] [--methods ...] [--out DIR]
-         [--registration-only]
+         [--registration-only] [--speed N]
 Rendered clips are cached in OUT/clips (default build/bench-stab-realworld); the report goes to
 stdout and OUT/results.md, the numbers to OUT/results.json.
 """
@@ -799,6 +799,46 @@ def report(results, clips, meta):
     return "\n".join(L) + "\n"
 
 
+def speed_run(ctx, clips, chosen, methods, work, repeat, label):
+    """Frames per CPU second of each method on each clip: the methods in turn, repeat times, one
+    process at a time and no measurement beside them (the quality run measures outputs in
+    parallel, which loads the machine while it times); the fastest run of each counts."""
+    rows, t0 = {}, time.time()
+    for clip in clips:
+        y4m, _ = ctx.render(clip)
+        n = y4m_frames(y4m)
+        best = {}
+        for _ in range(repeat):
+            for m in chosen:
+                out = work / "out" / ("speed_%s.y4m" % m.replace(" ", "_"))
+                cpu = sum(C.run(cmd)[1] for cmd in methods[m](str(y4m), str(out)))
+                best[m] = min(best.get(m, cpu), cpu)
+                for f in (out, Path(str(out) + ".trf")):
+                    if f.exists():
+                        f.unlink()
+        rows[clip.name] = {"frames": n, **{m: n / best[m] for m in chosen}}
+        print("%-24s %4d frames, %s (%.0f s)" % (clip.name, n, ", ".join(
+            "%s %.0f" % (m, rows[clip.name][m]) for m in chosen), time.time() - t0), flush=True)
+    head = "| clip | frames | " + " | ".join(chosen) + " |"
+    L = ["Frames per CPU second (the fastest of %d runs, methods in turn, one process at a "
+         "time)." % repeat, "", head, "|" + "---|" * (len(chosen) + 2)]
+    ratio = "home-stab la15" in chosen and "vidstab" in chosen
+    if ratio:
+        L[2] += " la15 / vidstab |"
+        L[3] += "---|"
+    for name, r in rows.items():
+        line = "| %s | %d | " % (name, r["frames"]) + " | ".join("%.0f" % r[m] for m in chosen)
+        L.append(line + (" | %.1fx |" % (r["home-stab la15"] / r["vidstab"]) if ratio else " |"))
+    if ratio:
+        x = sorted(r["home-stab la15"] / r["vidstab"] for r in rows.values())
+        L += ["", "la15 / vidstab: %.1f-%.1fx, median %.1fx" % (x[0], x[-1], x[len(x) // 2])]
+    L += ["", "Run: commit %s, load %s, wall %.0f s" % (
+        label, " ".join("%.1f" % v for v in os.getloadavg()), time.time() - t0)]
+    (work / "speed.md").write_text("\n".join(L) + "\n")
+    (work / "speed.json").write_text(json.dumps(rows, indent=1))
+    print("\n".join(L))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -816,6 +856,9 @@ def main():
     ap.add_argument("--jobs", type=int, default=2, help="processes measuring the outputs")
     ap.add_argument("--registration-only", action="store_true",
                     help="only home-stab's registrations against the truth (no methods)")
+    ap.add_argument("--speed", type=int, default=0, metavar="N",
+                    help="speed only: each method N times a clip, in turn, with nothing "
+                         "measured beside them; frames per CPU second of the fastest run")
     args = ap.parse_args()
     build = REPO / args.build
     work = Path(args.out) if args.out else build / "bench-stab-realworld"
@@ -842,6 +885,9 @@ def main():
     from common import git_describe
     ctx = Context(work, Path(args.cache), build)
     (work / "out").mkdir(parents=True, exist_ok=True)
+    if args.speed:
+        speed_run(ctx, clips, chosen, methods, work, args.speed, git_describe(build))
+        return
     results, pending = {}, []
     t0 = time.time()
     with concurrent.futures.ProcessPoolExecutor(max(args.jobs, 1)) as pool:
