@@ -23,7 +23,7 @@ Scenarios (each in the tuning and the test half, with other scenes and seeds):
              textured, low light (scenes.low_light instead of the noise)
 Real footage (no truth), visp-images-data's camera sequences at their native size (cropped to
 even): mire-2 (first 300 of its 502 frames), mbt/cube, cube, cube.mpeg (MPEG-1 of cube),
-mbt-depth/castel/castel, ellipse-1.
+mbt-depth/castel/castel, ellipse-1, line.
 Methods: compare.method_commands (home-stab causal and --lookahead 15, vidstab two-pass,
 deshake), each run as a whole process; frames per CPU second as in compare.py.
 Metrics (luma):
@@ -494,7 +494,9 @@ def catalogue():
              False),
             ("test", "cube", "cube", "cube on a table, moving camera", 0, None, False),
             ("test", "cube_mpeg", "video/cube.mpeg", "the cube sequence as MPEG-1 video", 0,
-             None, False)):
+             None, False),
+            ("test", "line", "line", "a dark band on white paper, moving camera: two long edges "
+             "on flat areas", 0, None, False)):
         add("real_" + name, half, "real", why, visp + sub, build_visp(sub, first, count), 0,
             quick)
     return clips
