@@ -324,10 +324,14 @@ typedef struct home_result {
  * identity is tried; it vouches like an overruling refinement and must stay within
  * refine_trust_px of the identity. Where that fails too (and nothing made the pair
  * inconsistent), with max_model a homography, every pixel of the quarter-size frames is
- * aligned from the identity, coarse to fine (HOME_REFINE_DENSE: slow shading, a soft
- * shadow): it vouches the same way with sigma_px <= 0.3 max_sigma_px (<= max_sigma_px when
- * the model chosen is simpler than a homography and more than 2 sigma_px from the identity),
- * reaches a pixel of its coarsest image (16 px at 640x360), and the refinement's points, where
+ * aligned coarse to fine from the best whole-pixel shift of its coarsest image within 4 of
+ * its pixels (HOME_REFINE_DENSE: slow shading, a soft shadow): it vouches the same way with
+ * sigma_px <= 0.3 max_sigma_px (<= max_sigma_px when the model chosen is simpler than a
+ * homography and more than 2 sigma_px from the identity; <= 0.45 max_sigma_px for a
+ * homography that left the identity with its information on a shift spread over 15 % of the
+ * pixels or more, not a few edges), lies within 1 + the shift's length pixels of its coarsest
+ * image from the identity (16 px at 640x360 without a shift, at most 107 px), and the
+ * refinement's points, where
  * they determine an optimum from it, must find it within 3 sigma_px. Regions that prefer the
  * identity to such a motion (below) make the pair inconsistent, not static. Where that gives
  * no answer either, HOME's estimate failed only as too uncertain and an agreeing refinement

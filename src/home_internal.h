@@ -92,9 +92,9 @@ typedef struct home__refine_state {
     uint32_t dense_ids[2];            /* the frames of the last dense alignment (0: none), */
     int dense_model;                  /* ... its cfg.max_model, */
     int dense_found;                  /* ... whether it found a motion, */
-    double dense_reach;               /* ... its reach and its answer (H, model, sigma_px and the
-                                         refine fields): home_register()'s second pass reuses
-                                         it */
+    double dense_reach, dense_spread; /* ... its reach, where its information sits and its
+                                         answer (H, model, sigma_px and the refine fields):
+                                         home_register()'s second pass reuses it */
     home_result dense_answer;
     const home__refine_kernels *rk;   /* SIMD backend, as cfg.simd */
     void *scratch;

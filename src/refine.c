@@ -66,6 +66,13 @@
                                  few edges over wide shading, or in low light) predicted
                                  0.34-0.52 px; a simpler model that left the identity, within
                                  max_sigma_px as any answer */
+#define DENSE_SPREAD 0.15     /* ... a homography whose information on a shift is spread over
+                                 this share of the pixels (smooth shading, not a few edges:
+                                 tuning set, 0.16-0.59 where right, the few-edges scene's wrong
+                                 ones 0.03-0.11) */
+#define DENSE_SPREAD_SIGMA_SHARE 0.45 /* ... vouches within this share of max_sigma_px (tuning
+                                         set: its right answers predicted 0.34-0.48 px, wrong
+                                         ones of smooth blobs 0.52 and more) */
 #define CONFIRM_SIGMAS 2.0    /* HOME's uncertain estimate and the refined one agree within this
                                  many of their combined predicted errors */
 #define CONFIRM_SHARE 0.97    /* ... with this share of the refined estimate's points within 3
@@ -191,14 +198,17 @@ static int confirms_uncertain(const home_context *ctx, const home_result *home,
 
 /* Does the dense alignment vouch for itself? As a refined estimate for the whole frame, but
  * by its model: a homography's perspective rests on the frame's faint periphery, and where the
- * alignment keeps it against simpler models its predicted error runs low; and a motion its
+ * alignment keeps it against simpler models its predicted error runs low, the more so where a
+ * few edges carry the information (spread: the share of pixels that do); and a motion its
  * predicted error cannot tell from the identity may be where the alignment started and stayed */
-static int dense_vouches(const home_context *ctx, const home_result *r)
+static int dense_vouches(const home_context *ctx, const home_result *r, double spread)
 {
     const int left_start = corner_distance(ctx, r->H, home__refine_identity) >
                            IDENTITY_SIGMAS * r->sigma_px;
-    const double bound =
-        r->model != HOME_MODEL_HOMOGRAPHY && left_start ? 1.0 : DENSE_SIGMA_SHARE;
+    const double bound = !left_start                          ? DENSE_SIGMA_SHARE
+                         : r->model != HOME_MODEL_HOMOGRAPHY ? 1.0
+                         : spread >= DENSE_SPREAD            ? DENSE_SPREAD_SIGMA_SHARE
+                                                             : DENSE_SIGMA_SHARE;
     return r->refine_zncc >= VOUCH_ZNCC && r->refine_inlier_share >= VOUCH_SHARE &&
            r->sigma_px <= bound * ctx->cfg.max_sigma_px;
 }
@@ -206,13 +216,14 @@ static int dense_vouches(const home_context *ctx, const home_result *r)
 /* home__refine_dense() on frames id_a (slot) and id_b, or its stored answer when it ran on
  * them last with the same max_model (home_register()'s passes share the frames). */
 static int dense_alignment(home_context *ctx, int slot, uint32_t id_a, uint32_t id_b,
-                           home_result *dense, double *reach)
+                           home_result *dense, double *reach, double *spread)
 {
     home__refine_state *st = &ctx->refine;
     if (!(st->dense_ids[0] == id_a && st->dense_ids[1] == id_b &&
           st->dense_model == ctx->cfg.max_model)) {
         st->dense_answer = *dense;
-        st->dense_found = home__refine_dense(ctx, slot, &st->dense_answer, &st->dense_reach);
+        st->dense_found = home__refine_dense(ctx, slot, &st->dense_answer, &st->dense_reach,
+                                             &st->dense_spread);
         st->dense_ids[0] = id_a;
         st->dense_ids[1] = id_b;
         st->dense_model = ctx->cfg.max_model;
@@ -225,6 +236,7 @@ static int dense_alignment(home_context *ctx, int slot, uint32_t id_a, uint32_t 
     dense->refined = st->dense_answer.refined;
     dense->refine_status = st->dense_answer.refine_status;
     *reach = st->dense_reach;
+    *spread = st->dense_spread;
     return st->dense_found;
 }
 
@@ -338,9 +350,9 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         ctx->cfg.max_model == HOME_MODEL_HOMOGRAPHY) {
         home_result dense = *result;
         const double reach = ctx->cfg.refine_trust_px * ctx->hough_scale;
-        double dense_reach;
-        if (dense_alignment(ctx, slot, id_a, id_b, &dense, &dense_reach) &&
-            dense_vouches(ctx, &dense) &&
+        double dense_reach, dense_spread;
+        if (dense_alignment(ctx, slot, id_a, id_b, &dense, &dense_reach, &dense_spread) &&
+            dense_vouches(ctx, &dense, dense_spread) &&
             corner_distance(ctx, dense.H, home__refine_identity) <=
                 (dense_reach > reach ? dense_reach : reach) &&
             points_agree(ctx, slot, &dense)) {

@@ -7,8 +7,8 @@
  * (refine.c calls it with a homography: a similarity fitted to a perspective motion is wrong
  * with a small predicted error) on the two slots' background16 images (quarter size, at most
  * HOME__BACKGROUND_PIXELS, in sixteenths of a grey level) and two 2x2 means of them, coarse to
- * fine from the identity, every interior pixel a template point; a gain and bias and Cauchy
- * weights as in the refinement. The predicted error comes from J^T W J without the apparent
+ * fine from the coarsest image's best whole-pixel shift, every interior pixel a template
+ * point; a gain and bias and Cauchy weights as in the refinement. The predicted error comes from J^T W J without the apparent
  * information of the template's gradient noise and of what the gain and bias explain, through
  * the same model selection as the refinement's: the larger of its homoscedastic prediction
  * and the sandwich with the scores summed over blocks of pixels (residuals that are not
@@ -20,6 +20,8 @@
 
 #define DENSE_LEVELS 3          /* the background image and two 2x2 means of it */
 #define DENSE_MIN_SIDE 12       /* a coarser image than this a side is not made */
+#define DENSE_SEARCH 4          /* the coarsest level's shifts tried first, level px either way */
+#define DENSE_SEARCH_OVERLAP 2  /* ... where at least 1 / this of its pixels overlap */
 #define DENSE_ITERATIONS 15     /* per level: one that does not converge ends the alignment */
 #define DENSE_STEP_EPS 0.01     /* convergence: largest corner update, level px */
 #define DENSE_HIST_BINS 256     /* |residual| histogram: 1/32 grey level per bin */
@@ -125,10 +127,11 @@ static void pixel_jacobian(const dense_solver *s, const dense_level *lv, const u
  * 3: the whole J^T W J, J^T W r, those sums, the gradient noise's sum w D^T D (noise), the
  * correlation's sums (corr[6] of w, w a, w b', w a^2, w b'^2, w a b') and J's weighted sums
  * against the gain's and the bias's derivatives (cross[16]: w J a, w J; the gain's taken as A,
- * which B matches at the optimum). Returns the pixels used. */
+ * which B matches at the optimum), and where the information on a shift sits (spread[2]: the
+ * sums of w |grad A|^2 and of its square). Returns the pixels used. */
 static int pass(const dense_solver *s, const dense_level *lv, int mode, double sigma,
                 int32_t *hist, double *sums, double *jtj, double *jtr, double *noise,
-                double *corr, double *cross)
+                double *corr, double *cross, double *spread)
 {
     double m[9];
     const double k = s->f / lv->scale; /* level px per normalised unit */
@@ -160,6 +163,12 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
             } else {
                 double jr[8], ddx[8], ddy[8];
                 pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
+                if (mode == 3) { /* where the information on a shift sits */
+                    const double gx = 0.5 * (ra[x + 1] - ra[x - 1]), gy = 0.5 * ((double)ra[x + lv->w] - ra[x - lv->w]);
+                    const double g2 = w * (gx * gx + gy * gy);
+                    spread[0] += g2;
+                    spread[1] += g2 * g2;
+                }
                 for (i = 0; i < s->k; i++) { /* mode 2: the lower triangle the solve reads */
                     const int columns = mode == 2 ? i + 1 : s->k;
                     jtr[i] += w * jr[i] * r;
@@ -231,7 +240,7 @@ static double robust_sigma(const dense_solver *s, const dense_level *lv, int32_t
 {
     int n, i, seen = 0;
     memset(hist, 0, DENSE_HIST_BINS * sizeof *hist);
-    n = pass(s, lv, 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL);
+    n = pass(s, lv, 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
     for (i = 0; i < DENSE_HIST_BINS; i++) {
         seen += hist[i];
         if (2 * seen >= n) break;
@@ -296,7 +305,7 @@ static int solve_k(const double *a8, const double *b, int k, double *x)
 }
 
 typedef struct dense_fit {
-    double jtj[64], jtr[8], noise[64], corr[6], cross[16], sum_w, sum_wr2, sigma;
+    double jtj[64], jtr[8], noise[64], corr[6], cross[16], spread[2], sum_w, sum_wr2, sigma;
     int n;
 } dense_fit;
 
@@ -308,7 +317,8 @@ static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int re
 {
     double sums[5] = {0}, det;
     if (rescale) fit->sigma = robust_sigma(s, lv, hist);
-    if (pass(s, lv, 1, fit->sigma, NULL, sums, NULL, NULL, NULL, NULL, NULL) < MIN_POINTS) return 0;
+    if (pass(s, lv, 1, fit->sigma, NULL, sums, NULL, NULL, NULL, NULL, NULL, NULL) < MIN_POINTS)
+        return 0;
     det = sums[0] * sums[3] - sums[1] * sums[1];
     if (det > 1e-9 * sums[0] * sums[3]) {
         s->alpha = (sums[0] * sums[4] - sums[1] * sums[2]) / det;
@@ -322,11 +332,55 @@ static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int re
     {
         double pair[2] = {0.0, 0.0};
         fit->n = pass(s, lv, full ? 3 : 2, fit->sigma, NULL, pair, fit->jtj, fit->jtr, fit->noise,
-                      fit->corr, fit->cross);
+                      fit->corr, fit->cross, fit->spread);
         fit->sum_w = pair[0];
         fit->sum_wr2 = pair[1];
     }
     return fit->n >= MIN_POINTS;
+}
+
+/* The start: the whole-pixel shift of the coarsest level within DENSE_SEARCH either way whose
+ * overlap correlates best (gain and bias free), as a translation in s->hn; its length in
+ * level px returned. Gauss-Newton from the identity reaches about a pixel of that level; a
+ * still pair of smooth shading moves farther. */
+static double coarse_shift(dense_solver *s, const dense_level *lv)
+{
+    double best = -2.0;
+    int dx, dy, bx = 0, by = 0, x, y;
+    for (dy = -DENSE_SEARCH; dy <= DENSE_SEARCH; dy++)
+        for (dx = -DENSE_SEARCH; dx <= DENSE_SEARCH; dx++) {
+            const int x0 = dx < 0 ? -dx : 0, x1 = dx > 0 ? lv->w - dx : lv->w;
+            const int y0 = dy < 0 ? -dy : 0, y1 = dy > 0 ? lv->h - dy : lv->h;
+            double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, n, va, vb, r;
+            if (DENSE_SEARCH_OVERLAP * (x1 - x0) * (y1 - y0) < lv->w * lv->h) continue;
+            for (y = y0; y < y1; y++) {
+                const uint16_t *ra = lv->a + (ptrdiff_t)y * lv->w;
+                const uint16_t *rb = lv->b + (ptrdiff_t)(y + dy) * lv->w + dx;
+                for (x = x0; x < x1; x++) {
+                    const double a = ra[x], b = rb[x];
+                    sa += a;
+                    sb += b;
+                    saa += a * a;
+                    sbb += b * b;
+                    sab += a * b;
+                }
+            }
+            n = (double)(x1 - x0) * (y1 - y0);
+            va = saa - sa * sa / n;
+            vb = sbb - sb * sb / n;
+            if (!(va > 0.0 && vb > 0.0)) continue;
+            r = (sab - sa * sb / n) / sqrt(va * vb);
+            /* a tie keeps the shorter shift */
+            if (r > best + 1e-12 ||
+                (fabs(r - best) <= 1e-12 && dx * dx + dy * dy < bx * bx + by * by)) {
+                best = r;
+                bx = dx;
+                by = dy;
+            }
+        }
+    s->hn[2] = bx * lv->scale / s->f;
+    s->hn[5] = by * lv->scale / s->f;
+    return sqrt((double)(bx * bx + by * by));
 }
 
 /* Build the levels: the slots' background16 images, then 2x2 sums of them in the match-time
@@ -433,7 +487,8 @@ typedef struct dense_work {
 typedef char home__dense_work_fits[sizeof(dense_work) <= 4 * REGION_CAPACITY * sizeof(float) ? 1
                                                                                               : -1];
 
-int home__refine_dense(home_context *ctx, int slot, home_result *result, double *reach_px)
+int home__refine_dense(home_context *ctx, int slot, home_result *result, double *reach_px,
+                       double *spread)
 {
     const home__refine_state *st = &ctx->refine;
     dense_work *wk = (dense_work *)st->scratch;
@@ -447,7 +502,7 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     home__model_choice choice, sandwich;
     double resid_var, var_g;
 
-    *reach_px = 0.0;
+    *reach_px = *spread = 0.0;
     if (!st->levels || ctx->cfg.max_model < HOME_MODEL_TRANSLATION) return 0;
     memset(&s, 0, sizeof s);
     s.ctx = ctx;
@@ -459,7 +514,7 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     s.beta = 0.0;
     set_model(&s, ctx->cfg.max_model);
     levels = make_levels(ctx, slot, lv);
-    *reach_px = lv[levels - 1].scale;
+    *reach_px = lv[levels - 1].scale * (1.0 + coarse_shift(&s, &lv[levels - 1]));
     for (level = levels - 1; level >= 0; level--) {
         converged = 0;
         /* the residuals' scale once per level: it changes little within one */
@@ -547,7 +602,7 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         int in = 0, n;
         result->refine_zncc = va > 0.0 && vb > 0.0 ? cab / sqrt(va * vb) : 0.0;
         memset(hist, 0, DENSE_HIST_BINS * sizeof *hist);
-        n = pass(&s, &lv[0], 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL);
+        n = pass(&s, &lv[0], 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
         for (i = 0; i < DENSE_HIST_BINS && i < within; i++) in += hist[i];
         result->refine_inlier_share = n ? (double)in / n : 0.0;
     }
@@ -565,5 +620,8 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     result->sigma_px = choice.sigma_px;
     result->refined = 1;
     result->refine_status = HOME_REFINE_DENSE;
+    /* the pixels that carry the information, as a share of those used: (sum g)^2 / sum g^2 */
+    if (fit.spread[1] > 0.0 && fit.n > 0)
+        *spread = fit.spread[0] * fit.spread[0] / fit.spread[1] / fit.n;
     return 1;
 }

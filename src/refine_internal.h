@@ -180,9 +180,12 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
  * allows, coarse to fine. 1 with result's H, model, sigma_px, refine_zncc and
  * refine_inlier_share (refine_status HOME_REFINE_DENSE) when it converged to a determined,
  * plausible motion; else 0 (result's refine_status may say why). *reach_px: a pixel of its
- * coarsest image, full-size px (how far from the identity it reaches). Uses st->sampled and
- * st->smoothed_b. */
-int home__refine_dense(home_context *ctx, int slot, home_result *result, double *reach_px);
+ * coarsest image, full-size px (how far from the identity it reaches). *spread: the share of
+ * its finest image's pixels that carry the information on a shift, (sum g)^2 / (n sum g^2) with
+ * g a pixel's weighted squared gradient (near 1: smooth shading everywhere; small: a few
+ * edges). Uses st->sampled and st->smoothed_b. */
+int home__refine_dense(home_context *ctx, int slot, home_result *result, double *reach_px,
+                       double *spread);
 
 /* refine_alias.c: 1 when the refinement, started from h shifted by one period of frame A's
  * repeated pattern either way (periods along a few directions, up to three of them tried),

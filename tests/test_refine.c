@@ -381,23 +381,38 @@ void test_noisy_refinement_confirms(void)
     CHECK(low_correlation >= 2); /* the case this is about */
 }
 
-/* Dim structured frames (a sixth of the contrast over a dark floor, noise 3): HOME's line fit
- * is only too uncertain (sigma_px above max_sigma_px), and the refinement next to it predicts
- * more than the 0.4 max_sigma_px it would need to vouch alone. Two measurements from different
- * evidence agreeing within their combined error, nearly every refined point consistent, are
- * the answer (the dense alignment, tried first, has none here); every ok answer is within
- * 3 predicted errors. */
+/* Dim structured frames (a tenth of the contrast over a dark floor, noise 3) under an affine
+ * motion, max_model affine (so no dense alignment, which answers such frames first under a
+ * homography cap): HOME's line fit is only too uncertain (sigma_px above max_sigma_px), and
+ * the refinement next to it predicts more than the 0.4 max_sigma_px it would need to vouch
+ * alone. Two measurements from different evidence agreeing within their combined error,
+ * nearly every refined point consistent, are the answer, within 3 predicted errors; every ok
+ * answer within 2 px. */
 void test_uncertain_lines_confirmed(void)
 {
-    home_context *ctx = context(NULL);
+    home_config cfg;
+    home_context *ctx;
     int k, i, ok = 0, confirmed = 0;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.max_model = HOME_MODEL_AFFINE; /* below a homography: no dense alignment */
+    ctx = context(&cfg);
     if (!ctx) { CHECK(0); return; }
     for (k = 0; k < 8; k++) {
         double h[9], err;
         home_result res;
         synth_rng rng;
         synth_seed(&rng, 3000 + k);
-        synth_corner_homography(&rng, IMG_W, IMG_H, 8.0, h);
+        { /* about the centre: 0.3-0.9 degrees, 1 % of scale, a little shear, 3-6 px */
+            const double a = (0.005 + 0.01 * synth_uniform(&rng)) * (k % 2 ? -1.0 : 1.0);
+            const double sc = 1.0 + 0.01 * (synth_uniform(&rng) - 0.5) * 2.0;
+            const double tx = 3.0 + 3.0 * synth_uniform(&rng), ty = -2.0 + 4.0 * synth_uniform(&rng);
+            const double cx = 0.5 * (IMG_W - 1), cy = 0.5 * (IMG_H - 1);
+            h[0] = sc * cos(a); h[1] = -sc * sin(a) + 0.006; h[3] = sc * sin(a); h[4] = sc * cos(a) - 0.008;
+            h[2] = cx + tx - h[0] * cx - h[1] * cy;
+            h[5] = cy + ty - h[3] * cx - h[4] * cy;
+            h[6] = h[7] = 0.0;
+            h[8] = 1.0;
+        }
         synth_render(SYNTH_STRUCTURED, (uint32_t)(3000 + k), identity, 0.0, 1, img_a, IMG_W, IMG_H, IMG_W);
         synth_render(SYNTH_STRUCTURED, (uint32_t)(3000 + k), h, 0.0, 2, img_b, IMG_W, IMG_H, IMG_W);
         for (i = 0; i < 2; i++) {
@@ -405,7 +420,7 @@ void test_uncertain_lines_confirmed(void)
             int j;
             synth_seed(&rng, 10 + 2 * k + i);
             for (j = 0; j < IMG_W * IMG_H; j++) {
-                const double v = 40.0 + 0.15 * im[j] + 3.0 * synth_gauss(&rng);
+                const double v = 40.0 + 0.10 * im[j] + 3.0 * synth_gauss(&rng);
                 im[j] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : v + 0.5);
             }
         }
@@ -417,12 +432,13 @@ void test_uncertain_lines_confirmed(void)
                err, res.sigma_px);
         if (!res.ok) continue;
         ok++;
-        confirmed += res.refine_status == HOME_REFINE_ACCEPTED && res.sigma_px > 0.4;
-        CHECK_LT(err, 1.0);
+        CHECK_LT(err, 2.0);
+        if (res.refine_status != HOME_REFINE_ACCEPTED || res.sigma_px <= 0.4) continue;
+        confirmed++; /* more than a refinement may predict to vouch alone */
         CHECK_LT(err, 3.0 * res.sigma_px);
     }
     CHECK(confirmed >= 2); /* the case this is about */
-    CHECK(ok >= 5);
+    CHECK(ok >= 6);
 }
 
 /* Four plane waves of 300-900 px, 8-25 grey levels (faint: each times 0.3-1). */
@@ -490,6 +506,43 @@ void test_dense_shading(void)
                home_failure_name(res.failure), home_refine_status_name(res.refine_status));
         CHECK(!res.ok || res.model == HOME_MODEL_IDENTITY);
     }
+}
+
+/* Still pairs of slow shading under a perspective that moves the corners 17-40 px: beyond a
+ * pixel of the dense alignment's coarsest image (16 px) from the identity, reached from the
+ * best whole-pixel shift there; a homography resting on shading spread over the whole frame
+ * may predict up to 0.45 max_sigma_px. Every ok answer lies within 2 px and 3 predicted
+ * errors. */
+void test_dense_still_pairs(void)
+{
+    home_context *ctx = context(NULL);
+    int k, ok = 0, far = 0;
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 8; k++) {
+        texture t;
+        synth_rng rng;
+        home_result res;
+        double h[9], err, motion;
+        synth_seed(&rng, 2400 + k);
+        shading_waves(&t, &rng, 0);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 30.0, h);
+        motion = synth_corner_error(identity, h, IMG_W, IMG_H);
+        render_texture(&t, identity, 1.0, 2.5, 2500 + 2 * k, img_a);
+        render_texture(&t, h, 1.0, 2.5, 2501 + 2 * k, img_b);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
+        printf("     pair %d (corners %.1f px): ok %d, %s, %s, %s, error %.3f px, sigma %.3f px\n",
+               k, motion, res.ok, home_failure_name(res.failure),
+               home_refine_status_name(res.refine_status), home_model_name(res.model), err,
+               res.sigma_px);
+        if (!res.ok) continue;
+        ok++;
+        far += motion > 16.0 && res.refine_status == HOME_REFINE_DENSE;
+        CHECK_LT(err, 2.0);
+        CHECK_LT(err, 3.0 * res.sigma_px);
+    }
+    printf("     %d ok, %d of them dense beyond 16 px\n", ok, far);
+    CHECK(far >= 3); /* the case this is about */
 }
 
 /* Dim frames of faint shading (gain 0.3-1, waves of 2-25 grey levels, noise 2-6, a small
@@ -820,7 +873,7 @@ void test_refine_bad_inputs(void)
 
 #define TEST_LIST(X) \
     X(kernels_match_references) X(arena_and_config) X(region_grid_exact) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
-    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_dim_calibrated) \
+    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
 
