@@ -331,9 +331,9 @@ typedef struct home_result {
  * homography that left the identity with its information on a shift spread over 15 % of the
  * pixels or more, not a few edges), lies within 1 + the shift's length pixels of its coarsest
  * image from the identity (16 px at 640x360 without a shift, at most 107 px), and the
- * refinement's points, where
- * they determine an optimum from it, must find it within 3 sigma_px. Regions that prefer the
- * identity to such a motion (below) make the pair inconsistent, not static. Where that gives
+ * refinement's points, where they determine an optimum from it, must find it within 3
+ * sigma_px. Regions that prefer the identity to such a motion (below) make the pair
+ * inconsistent, not static. Where that gives
  * no answer either, HOME's estimate failed only as too uncertain and an agreeing refinement
  * that could not vouch confirm each other when the refined H predicts sigma_px <=
  * max_sigma_px, refine_zncc >= 0.9 and refine_inlier_share >= 0.97, and the two lie within 2

@@ -8,12 +8,12 @@
  * with a small predicted error) on the two slots' background16 images (quarter size, at most
  * HOME__BACKGROUND_PIXELS, in sixteenths of a grey level) and two 2x2 means of them, coarse to
  * fine from the coarsest image's best whole-pixel shift, every interior pixel a template
- * point; a gain and bias and Cauchy weights as in the refinement. The predicted error comes from J^T W J without the apparent
- * information of the template's gradient noise and of what the gain and bias explain, through
- * the same model selection as the refinement's: the larger of its homoscedastic prediction
- * and the sandwich with the scores summed over blocks of pixels (residuals that are not
- * independent: an edge the motion model does not quite fit, blur that differs between
- * frames). */
+ * point; a gain and bias and Cauchy weights as in the refinement. The predicted error comes
+ * from J^T W J without the apparent information of the template's gradient noise and of what
+ * the gain and bias explain, through the same model selection as the refinement's: the larger
+ * of its homoscedastic prediction and the sandwich with the scores summed over blocks of
+ * pixels (residuals that are not independent: an edge the motion model does not quite fit,
+ * blur that differs between frames). */
 #include "refine_internal.h"
 #include <math.h>
 #include <string.h>
@@ -164,7 +164,8 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
                 double jr[8], ddx[8], ddy[8];
                 pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
                 if (mode == 3) { /* where the information on a shift sits */
-                    const double gx = 0.5 * (ra[x + 1] - ra[x - 1]), gy = 0.5 * ((double)ra[x + lv->w] - ra[x - lv->w]);
+                    const double gx = 0.5 * (ra[x + 1] - ra[x - 1]);
+                    const double gy = 0.5 * ((double)ra[x + lv->w] - ra[x - lv->w]);
                     const double g2 = w * (gx * gx + gy * gy);
                     spread[0] += g2;
                     spread[1] += g2 * g2;

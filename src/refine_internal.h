@@ -179,8 +179,9 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
  * background16 images and two 2x2 means of them, in the most general model cfg.max_model
  * allows, coarse to fine. 1 with result's H, model, sigma_px, refine_zncc and
  * refine_inlier_share (refine_status HOME_REFINE_DENSE) when it converged to a determined,
- * plausible motion; else 0 (result's refine_status may say why). *reach_px: a pixel of its
- * coarsest image, full-size px (how far from the identity it reaches). *spread: the share of
+ * plausible motion; else 0 (result's refine_status may say why). *reach_px: 1 + the length
+ * of its start's shift, in pixels of its coarsest image, as full-size px (how far from the
+ * identity it reaches). *spread: the share of
  * its finest image's pixels that carry the information on a shift, (sum g)^2 / (n sum g^2) with
  * g a pixel's weighted squared gradient (near 1: smooth shading everywhere; small: a few
  * edges). Uses st->sampled and st->smoothed_b. */
