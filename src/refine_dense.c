@@ -93,8 +93,9 @@ static double cauchy_weight(double r, double sigma)
 }
 
 /* The pixel's row of J (k entries: the template's gradient times the warp's derivatives by
- * the model's parameters, normalised units) and those derivatives (x, y). */
-static void pixel_jacobian(const dense_solver *s, const dense_level *lv, const uint16_t *ra,
+ * the model's parameters, normalised units) and those derivatives (x, y); returns the squared
+ * magnitude of that gradient. */
+static double pixel_jacobian(const dense_solver *s, const dense_level *lv, const uint16_t *ra,
                            int x, double v, double *jr, double *ddx, double *ddy)
 {
     const double k = s->f / lv->scale; /* level px per normalised unit */
@@ -119,6 +120,7 @@ static void pixel_jacobian(const dense_solver *s, const dense_level *lv, const u
         }
         jr[i] = gx * ddx[i] + gy * ddy[i];
     }
+    return gx * gx + gy * gy;
 }
 
 /* One pass over the level's interior pixels under s->hn. mode 0: the |residual| histogram;
@@ -162,11 +164,8 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
                 sums[4] += w * a * b;
             } else {
                 double jr[8], ddx[8], ddy[8];
-                pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
+                const double g2 = w * pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
                 if (mode == 3) { /* where the information on a shift sits */
-                    const double gx = 0.5 * (ra[x + 1] - ra[x - 1]);
-                    const double gy = 0.5 * ((double)ra[x + lv->w] - ra[x - lv->w]);
-                    const double g2 = w * (gx * gx + gy * gy);
                     spread[0] += g2;
                     spread[1] += g2 * g2;
                 }

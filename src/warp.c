@@ -104,6 +104,12 @@ static void inside_span(int64_t c0, int64_t d, int64_t c_max, int64_t *lo, int64
     if (*hi < *lo) *hi = *lo;
 }
 
+/* Sample i's coordinate on a row from c0 by steps d (Q16, wrapping as the reference's sum). */
+static int32_t sample_at(int32_t c0, int32_t d, int i)
+{
+    return (int32_t)((uint32_t)c0 + (uint32_t)i * (uint32_t)d);
+}
+
 /* One output row (home__warp_row_c's contract) by the table k: its body kernel takes the part
  * of a planar row inside the source up to a multiple of its block, the reference the rest (a
  * crop that reaches the frame's last column or row, or the identity, still warps in SIMD). */
@@ -112,28 +118,23 @@ void home__warp_row(const home__stab_kernels *k, const uint8_t *src, ptrdiff_t s
                     int dst_step, int n)
 {
     int64_t lo = 0, hi = n;
-    int first, body;
+    int first, end;
     if (step != 1 || dst_step != 1) {
         home__warp_row_c(src, stride, step, w, h, x0, y0, dx, dy, dst, dst_step, n);
         return;
     }
     inside_span(x0, dx, (int64_t)(w - 1) << HOME__WARP_FRAC_BITS, &lo, &hi);
     inside_span(y0, dy, (int64_t)(h - 1) << HOME__WARP_FRAC_BITS, &lo, &hi);
-    first = (int)lo;
-    body = (int)(hi - lo) & ~(k->block - 1); /* a power of two: no division (armv7 has none) */
-    if (body <= 0) {
-        home__warp_row_c(src, stride, 1, w, h, x0, y0, dx, dy, dst, 1, n);
-        return;
-    }
+    first = lo < n ? (int)lo : n; /* past the row's end: no sample inside */
+    /* a power of two: no division (armv7 has none) */
+    end = first + ((int)(hi - lo) & ~(k->block - 1));
     if (first > 0) home__warp_row_c(src, stride, 1, w, h, x0, y0, dx, dy, dst, 1, first);
-    k->warp_row(src, stride, w, (int32_t)((uint32_t)x0 + (uint32_t)first * (uint32_t)dx),
-                (int32_t)((uint32_t)y0 + (uint32_t)first * (uint32_t)dy), dx, dy, dst + first,
-                body);
-    if (first + body < n)
-        home__warp_row_c(src, stride, 1, w, h,
-                         (int32_t)((uint32_t)x0 + (uint32_t)(first + body) * (uint32_t)dx),
-                         (int32_t)((uint32_t)y0 + (uint32_t)(first + body) * (uint32_t)dy), dx,
-                         dy, dst + first + body, 1, n - first - body);
+    if (end > first)
+        k->warp_row(src, stride, w, sample_at(x0, dx, first), sample_at(y0, dy, first), dx, dy,
+                    dst + first, end - first);
+    if (end < n)
+        home__warp_row_c(src, stride, 1, w, h, sample_at(x0, dx, end), sample_at(y0, dy, end),
+                         dx, dy, dst + end, 1, n - end);
 }
 
 static int32_t to_q16(double v) { return (int32_t)floor(v * 65536.0 + 0.5); }
