@@ -317,19 +317,22 @@ typedef struct home_result {
  * Farther away the two disagree: the refined H is the result only when it vouches for the
  * whole frame (also refine_inlier_share >= 0.9) and a second refinement, started halfway
  * between the two, reaches it too (within 3 sigma_px, at least 0.5 px), else the pair fails
- * (HOME_FAIL_INCONSISTENT).
+ * (HOME_FAIL_INCONSISTENT). Where HOME's own estimate was not ok and the refined H is a
+ * homography, its sigma_px is at least the largest distance to the optima that refinements
+ * started 4 px to either side of it along each axis reach and vouch for (a few dim edges leave
+ * several).
  * A refinement that cannot converge although the frame has texture refutes HOME's estimate
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the
- * identity is tried; it vouches like an overruling refinement and must stay within
- * refine_trust_px of the identity. Where that fails too (and nothing made the pair
+ * identity is tried; it vouches like an overruling refinement, must stay within
+ * refine_trust_px of the identity and may not be a homography. Where that fails too (and nothing made the pair
  * inconsistent), with max_model a homography, every pixel of the quarter-size frames is
  * aligned coarse to fine from the best whole-pixel shift of its coarsest image within 4 of
  * its pixels (HOME_REFINE_DENSE: slow shading, a soft shadow): it vouches the same way with
- * sigma_px <= 0.3 max_sigma_px (<= max_sigma_px when the model chosen is simpler than a
- * homography and more than 2 sigma_px from the identity; <= 0.45 max_sigma_px for a
- * homography that left the identity with its information on a shift spread over 15 % of the
- * pixels or more, not a few edges), lies within 1 + the shift's length pixels of its coarsest
+ * sigma_px <= 0.3 max_sigma_px within 2 sigma_px of the identity; farther, a translation or
+ * a similarity with sigma_px <= max_sigma_px, a homography with sigma_px <= 0.45
+ * max_sigma_px when its information on a shift is spread over 15 % of the pixels or more, else
+ * (a few edges) <= 0.15 max_sigma_px, never an affine motion; it lies within 1 + the shift's length pixels of its coarsest
  * image from the identity (16 px at 640x360 without a shift, at most 107 px), and the
  * refinement's points, where they determine an optimum from it, must find it within 3
  * sigma_px. Regions that prefer the identity to such a motion (below) make the pair

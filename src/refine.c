@@ -61,11 +61,17 @@
                                  ones less than 0.4 */
 #define VOUCH_SHARE 0.9      /* ... and this share of its points within 3 robust sigmas (both
                                 against HOME's estimate or with none; either beside it) */
-#define DENSE_SIGMA_SHARE 0.3 /* a homography of the dense alignment vouches within this share
-                                 of max_sigma_px: the tuning set's wrong dense homographies (a
-                                 few edges over wide shading, or in low light) predicted
-                                 0.34-0.52 px; a simpler model that left the identity, within
-                                 max_sigma_px as any answer */
+#define DENSE_SIGMA_SHARE 0.3 /* a motion of the dense alignment within 2 sigma_px of the
+                                 identity, where it started, vouches within this share of
+                                 max_sigma_px; one farther, by its model: a translation or a
+                                 similarity within max_sigma_px as any answer, a homography as
+                                 below, an affine motion not at all (the tuning set's few-edges
+                                 and smooth-blob frames: 22 of 39 more than 2 px off at a
+                                 predicted 0.12-0.95 px, docs/trust.md session 23) */
+#define DENSE_FEW_SIGMA_SHARE 0.15 /* ... a homography whose information a few edges hold
+                                      (spread below DENSE_SPREAD), within this share (tuning
+                                      set: the few-edges frames' 1-12 px off at 0.17-0.29 px,
+                                      right line-rich pairs 0.08-0.11 px) */
 #define DENSE_SPREAD 0.15     /* ... a homography whose information on a shift is spread over
                                  this share of the pixels (smooth shading, not a few edges:
                                  tuning set, 0.16-0.59 where right, the few-edges scene's wrong
@@ -80,6 +86,7 @@
                                  objects over static fog 0.90-0.94, right answers 0.98 and more) */
 #define SAME_OPTIMUM_FLOOR_PX 0.5 /* overruling HOME: the same optimum from another start,
                                      within 3 sigma_px or this */
+#define PROBE_PX 4.0          /* probe_spread(): its starts' offset, full-size px */
 
 /* Largest distance of the image corners under two pixel homographies (NaN: infinitely far). */
 static double corner_distance(const home_context *ctx, const double *h1, const double *h2)
@@ -208,7 +215,9 @@ static int dense_vouches(const home_context *ctx, const home_result *r, double s
     const double bound = !left_start                          ? DENSE_SIGMA_SHARE
                          : r->model != HOME_MODEL_HOMOGRAPHY ? 1.0
                          : spread >= DENSE_SPREAD            ? DENSE_SPREAD_SIGMA_SHARE
-                                                             : DENSE_SIGMA_SHARE;
+                                                             : DENSE_FEW_SIGMA_SHARE;
+    /* an affine motion that left the start is not vouched for at any predicted error */
+    if (left_start && r->model == HOME_MODEL_AFFINE) return 0;
     return r->refine_zncc >= VOUCH_ZNCC && r->refine_inlier_share >= VOUCH_SHARE &&
            r->sigma_px <= bound * ctx->cfg.max_sigma_px;
 }
@@ -254,6 +263,32 @@ static int points_agree(home_context *ctx, int slot, const home_result *dense)
     return corner_distance(ctx, check.H, dense->H) <= tolerance;
 }
 
+/* How far apart the optima lie that the refinement reaches from PROBE_PX to either side of
+ * refined's H along each axis and vouches for (full-size px at the corners; 0 when every start
+ * comes back). The same data from another start: a well-determined optimum is reached again
+ * within the convergence tolerance. Beside an estimate HOME cannot vouch for, a homography
+ * fitted to a few dim edges may stop in one of several optima, or anywhere along a flat
+ * valley, each predicting a small error (docs/trust.md, session 23). */
+static double probe_spread(home_context *ctx, int slot, const home_result *refined)
+{
+    static const double shifts[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+    double spread = 0.0;
+    int k;
+    for (k = 0; k < 4; k++) {
+        home_result probe = *refined;
+        double start[9], d;
+        memcpy(start, refined->H, sizeof start);
+        start[2] += PROBE_PX * shifts[k][0];
+        start[5] += PROBE_PX * shifts[k][1];
+        probe.refined = 0;
+        home__refine_run(ctx, slot, start, 0, &probe);
+        if (!probe.refined || !vouches(ctx, &probe, 0)) continue;
+        d = corner_distance(ctx, probe.H, refined->H);
+        if (d > spread) spread = d;
+    }
+    return spread;
+}
+
 /* Failure rule with the refinement (documented in home.h at home_match). */
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
 {
@@ -283,8 +318,10 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
                              &trial);
     if (!has_estimate) {
         /* a local method vouches only within its reach: the identity is a start whose
-         * uncertainty is the trust floor */
-        if (trial.refined && vouches(ctx, &trial, 1) &&
+         * uncertainty is the trust floor; and not for a homography, whose perspective nothing
+         * but the photometric fit then fixes (a few dim edges: 11 of the tuning set's 12 such
+         * answers were 1.9-9.4 px off at a predicted 0.2-0.4 px, docs/trust.md session 23) */
+        if (trial.refined && vouches(ctx, &trial, 1) && trial.model != HOME_MODEL_HOMOGRAPHY &&
             corner_distance(ctx, trial.H, home__refine_identity) <=
                 ctx->cfg.refine_trust_px * ctx->hough_scale) {
             trial.ok = 1;
@@ -317,6 +354,12 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         } else if (agrees ? result->ok || vouches(ctx, &trial, 0)
                           : vouches(ctx, &trial, 1) &&
                                 same_optimum(ctx, slot, result->H, patient, &trial)) {
+            /* a homography on the photometric evidence alone: its error is at least the
+             * spread of the optima other starts reach */
+            if (!result->ok && trial.model == HOME_MODEL_HOMOGRAPHY) {
+                const double spread = probe_spread(ctx, slot, &trial);
+                if (spread > trial.sigma_px) trial.sigma_px = spread;
+            }
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
         } else {

@@ -546,16 +546,17 @@ void test_dense_still_pairs(void)
 }
 
 /* Dim frames of faint shading (gain 0.3-1, waves of 2-25 grey levels, noise 2-6, a small
- * rotation and shift): the dense alignment answers some with a translation, similarity or
- * affine motion predicting up to max_sigma_px; every answer it vouches for lies within 2 px and
- * 3 predicted errors of the truth (iterating on past the cap while the steps shrink made one of
- * these 1.6 px off at a predicted 0.44 px: docs/trust.md). */
+ * rotation and shift): the dense alignment answers some with a translation or a similarity
+ * predicting up to max_sigma_px (an affine motion it no longer vouches for: docs/trust.md,
+ * session 23); every answer it vouches for lies within 2 px and 3 predicted errors of the truth
+ * (iterating on past the cap while the steps shrink made one of these 1.6 px off at a
+ * predicted 0.44 px: docs/trust.md). */
 void test_dense_dim_calibrated(void)
 {
     home_context *ctx = context(NULL);
     int k, ok = 0;
     if (!ctx) { CHECK(0); return; }
-    for (k = 0; k < 24; k++) {
+    for (k = 0; k < 40; k++) {
         texture t;
         synth_rng rng;
         home_result res;
@@ -581,7 +582,108 @@ void test_dense_dim_calibrated(void)
         CHECK_LT(err, 2.0);
         CHECK_LT(err, 3.0 * res.sigma_px);
     }
-    CHECK(ok >= 2); /* not vacuous */
+    CHECK(ok >= 4); /* not vacuous */
+}
+
+/* A few long edges (3-6 anti-aliased steps of 15-45 grey levels across a flat floor, a gentle
+ * illumination gradient), seen through h: by day (gain 1) with noise 2.5, else one low-light
+ * capture: brightness times gain, shot noise (Gaussian, of the electrons' variance at 4 per
+ * grey level) and read noise 1.5. */
+static void render_few_edges_dim(synth_rng *scene, const double *h, double gain, uint64_t seed,
+                                 uint8_t *out)
+{
+    double px[6], py[6], c[6], s[6], step[6], base, gx, gy, inv[9];
+    int n, i, x, y;
+    synth_rng rng = *scene;
+    synth_rng noise;
+    base = 90.0 + 80.0 * synth_uniform(&rng);
+    n = 3 + (int)(4.0 * synth_uniform(&rng));
+    for (i = 0; i < n; i++) {
+        const double th = 3.14159265358979 * synth_uniform(&rng);
+        px[i] = (0.2 + 0.6 * synth_uniform(&rng)) * IMG_W;
+        py[i] = (0.2 + 0.6 * synth_uniform(&rng)) * IMG_H;
+        c[i] = cos(th);
+        s[i] = sin(th);
+        step[i] = (synth_uniform(&rng) < 0.5 ? -1.0 : 1.0) * (15.0 + 30.0 * synth_uniform(&rng));
+    }
+    gx = 2.0 * synth_uniform(&rng) - 1.0;
+    gy = 2.0 * synth_uniform(&rng) - 1.0;
+    synth_invert(h, inv);
+    synth_seed(&noise, seed);
+    for (y = 0; y < IMG_H; y++)
+        for (x = 0; x < IMG_W; x++) {
+            double sx, sy, v = base, e;
+            synth_apply(inv, x, y, &sx, &sy);
+            for (i = 0; i < n; i++)
+                v += step[i] * 0.5 * (1.0 + tanh(((sx - px[i]) * c[i] + (sy - py[i]) * s[i]) / 0.7));
+            v += 12.0 * (gx * (sx / IMG_W - 0.5) + gy * (sy / IMG_H - 0.5));
+            if (gain >= 1.0) {
+                v += 2.5 * synth_gauss(&noise);
+            } else {
+                e = (v < 0.0 ? 0.0 : v) * gain * 4.0; /* electrons */
+                e += sqrt(e) * synth_gauss(&noise);
+                v = e / 4.0 + 1.5 * synth_gauss(&noise);
+            }
+            out[y * IMG_W + x] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : floor(v + 0.5));
+        }
+}
+
+/* Consecutive frames of a few long edges, dim (low-light captures, gain 0.10-0.25) or by day
+ * (noise 2.5), a hand-held camera between them (1-4 px, a tenth of a degree, a slight
+ * keystone). Where HOME finds a few lines at most, a homography the refinement or the dense
+ * alignment fits to the pixels alone may stop in one of several optima, each predicting a
+ * small error. Thirteen frames of a sweep of 240: five that session 23's rules (docs/trust.md)
+ * turned from answers 2.5-4.3 px off at a predicted 0.29-0.34 px, or a dense affine answer
+ * 1.15 px off at 0.72, into failures; one whose homography is now as uncertain as the optima
+ * other starts reach; seven answered right before and after. Every answer vouched for lies
+ * within 2 px and 3 predicted errors. */
+void test_few_edges_dim_calibrated(void)
+{
+    static const int frames[] = {44, 49, 51, 53, 72, 84, 86, 140, 172, 174, 176, 220, 226};
+    home_context *ctx = context(NULL);
+    int f, ok = 0;
+    if (!ctx) { CHECK(0); return; }
+    for (f = 0; f < (int)(sizeof frames / sizeof frames[0]); f++) {
+        const int k = frames[f];
+        const double cx = 0.5 * (IMG_W - 1), cy = 0.5 * (IMG_H - 1);
+        synth_rng rng, scene;
+        home_result res;
+        double h[9], r[9], m[9], err, gain, angle, tx, ty, g0, g1;
+        int i, j;
+        synth_seed(&scene, 4000 + (uint64_t)(k / 8));
+        synth_seed(&rng, 4100 + (uint64_t)k);
+        tx = 1.0 + 3.0 * synth_uniform(&rng);
+        ty = 3.0 * (synth_uniform(&rng) - 0.5);
+        g0 = 4e-6 * (synth_uniform(&rng) - 0.5);
+        g1 = 4e-6 * (synth_uniform(&rng) - 0.5);
+        angle = 0.004 * (synth_uniform(&rng) - 0.5);
+        /* h = T(c + t) r T(-c), r a roll with a keystone row */
+        r[0] = cos(angle); r[1] = -sin(angle); r[2] = 0.0;
+        r[3] = sin(angle); r[4] = cos(angle); r[5] = 0.0;
+        r[6] = g0; r[7] = g1; r[8] = 1.0;
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++)
+                m[i * 3 + j] = j < 2 ? r[i * 3 + j] : r[i * 3 + 2] - r[i * 3] * cx - r[i * 3 + 1] * cy;
+        for (j = 0; j < 3; j++) {
+            h[j] = m[j] + (cx + tx) * m[6 + j];
+            h[3 + j] = m[3 + j] + (cy + ty) * m[6 + j];
+            h[6 + j] = m[6 + j];
+        }
+        for (j = 0; j < 9; j++) h[j] /= h[8];
+        gain = k % 2 ? 1.0 : 0.10 + 0.15 * synth_uniform(&rng);
+        render_few_edges_dim(&scene, identity, gain, 4200 + 2 * (uint64_t)k, img_a);
+        render_few_edges_dim(&scene, h, gain, 4201 + 2 * (uint64_t)k, img_b);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
+        printf("     frame %3d: ok %d, %s, %s, %s, %d inliers, error %.3f px, sigma %.3f px\n", k,
+               res.ok, home_failure_name(res.failure), home_refine_status_name(res.refine_status),
+               home_model_name(res.model), res.inliers, err, res.sigma_px);
+        if (!res.ok) continue;
+        ok++;
+        CHECK_LT(err, 2.0);
+        CHECK_LT(err, 3.0 * res.sigma_px);
+    }
+    CHECK(ok >= 6); /* not vacuous */
 }
 
 void test_trust_region(void)
@@ -873,7 +975,7 @@ void test_refine_bad_inputs(void)
 
 #define TEST_LIST(X) \
     X(kernels_match_references) X(arena_and_config) X(region_grid_exact) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
-    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) \
+    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) X(few_edges_dim_calibrated) \
     X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
 
