@@ -333,7 +333,7 @@ def video_scenes(which):
                 Item("notebook and elastic band", photo=_tp("ela_original")),
                 Item("apple: smooth shading", photo=APPLE),
                 Item("few edges on flat areas", scene=("few_edges", "A", "v0")),
-                Item("ridge in fog", scene=("fog_horizon", "A", "v0"))]
+                Item("ridge in fog", scene=("fog_horizon", "A", "v0"))] + _more_scenes("A")
     if which == "sealed":
         return []
     return [Item(T["room"].why, photo=T["room"]),
@@ -343,7 +343,18 @@ def video_scenes(which):
             Item(T["camera"].why, photo=T["camera"]),
             Item(T["cliff"].why, photo=T["cliff"]),
             Item("wall, floor line and a door", scene=("few_edges", "B", "v0")),
-            Item("cosine field and a soft shadow", scene=("textureless", "B", "v0"))]
+            Item("cosine field and a soft shadow", scene=("textureless", "B", "v0"))] + \
+        _more_scenes("B")
+
+
+def _more_scenes(variant):
+    """Session 23: one sequence per hard scene let rules fit that sequence; more seeds of the
+    scenes that break methods (six of few edges, three each of textureless, fog and dim
+    gradients), from the set's own generator."""
+    kinds = [("few_edges", 6, "few edges"), ("textureless", 3, "textureless"),
+             ("fog_horizon", 3, "horizon in fog"), ("dim_gradient", 3, "dim gradient")]
+    return [Item(f"{why}, seed v{i}", scene=(kind, variant, f"v{i}"))
+            for kind, n, why in kinds for i in range(1, n + 1)]
 
 
 # -- static camera, moving objects --------------------------------------------
