@@ -325,22 +325,22 @@ typedef struct home_result {
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the
  * identity is tried; it vouches like an overruling refinement, must stay within
- * refine_trust_px of the identity and may not be a homography. Where that fails too (and nothing made the pair
- * inconsistent), with max_model a homography, every pixel of the quarter-size frames is
- * aligned coarse to fine from the best whole-pixel shift of its coarsest image within 4 of
- * its pixels (HOME_REFINE_DENSE: slow shading, a soft shadow): it vouches the same way with
- * sigma_px <= 0.3 max_sigma_px within 2 sigma_px of the identity; farther, a translation or
- * a similarity with sigma_px <= max_sigma_px, a homography with sigma_px <= 0.45
- * max_sigma_px when its information on a shift is spread over 15 % of the pixels or more, else
- * (a few edges) <= 0.15 max_sigma_px, never an affine motion; it lies within 1 + the shift's length pixels of its coarsest
- * image from the identity (16 px at 640x360 without a shift, at most 107 px), and the
- * refinement's points, where they determine an optimum from it, must find it within 3
- * sigma_px. Regions that prefer the identity to such a motion (below) make the pair
- * inconsistent, not static. Where that gives
- * no answer either, HOME's estimate failed only as too uncertain and an agreeing refinement
- * that could not vouch confirm each other when the refined H predicts sigma_px <=
- * max_sigma_px, refine_zncc >= 0.9 and refine_inlier_share >= 0.97, and the two lie within 2
- * of their combined predicted errors (sqrt of the sum of both sigma_px squared): the refined H.
+ * refine_trust_px of the identity and may not be a homography. Where that fails too (and
+ * nothing made the pair inconsistent), with max_model a homography, every pixel of the
+ * quarter-size frames is aligned coarse to fine from the best whole-pixel shift of its
+ * coarsest image within 4 of its pixels (HOME_REFINE_DENSE: slow shading, a soft shadow): it
+ * vouches the same way with sigma_px <= 0.3 max_sigma_px within 2 sigma_px of the identity;
+ * farther, a translation or a similarity with sigma_px <= max_sigma_px, a homography with
+ * sigma_px <= 0.45 max_sigma_px when its information on a shift is spread over 15 % of the
+ * pixels or more, else (a few edges) <= 0.15 max_sigma_px, never an affine motion; it lies
+ * within 1 + the shift's length pixels of its coarsest image from the identity (16 px at
+ * 640x360 without a shift, at most 107 px), and the refinement's points, where they determine
+ * an optimum from it, must find it within 3 sigma_px. Regions that prefer the identity to such
+ * a motion (below) make the pair inconsistent, not static. Where that gives no answer either,
+ * HOME's estimate failed only as too uncertain and an agreeing refinement that could not vouch
+ * confirm each other when the refined H predicts sigma_px <= max_sigma_px, refine_zncc >= 0.9
+ * and refine_inlier_share >= 0.97, and the two lie within 2 of their combined predicted errors
+ * (sqrt of the sum of both sigma_px squared): the refined H.
  *
  * Static camera: an ok motion within 2 sigma_px of the identity, or one that most regions of an
  * 8x6 grid explain worse than the identity does (each region votes with its own strongest
