@@ -28,9 +28,12 @@
 #define DENSE_SIGMA_FLOOR 0.1   /* grey levels: coarse images average the noise away */
 #define CLUSTER_SIDE 8          /* the covariance's blocks of pixels, finest dense level */
 #define DENSE_MAX_CLUSTERS 32   /* block columns at most (wider images share the last) */
-/* var(g) of a central difference over 2 is half a pixel's noise variance, and the residual
- * holds two frames' noise: a quarter of the residual variance */
-#define DENSE_GRADIENT_NOISE_SHARE 0.25
+/* var(g) of a central difference over 2 is half a pixel's noise variance; the residual holds
+ * frame A's noise and B's interpolated at a fractional position, its variance times the sum of
+ * the bilinear weights squared (4/9 on average): 0.5 / (1 + 4/9) of the residual variance (an
+ * integer shift's 0.25 let a single smooth blob's unseen turn about its centre look determined:
+ * docs/trust.md, session 23) */
+#define DENSE_GRADIENT_NOISE_SHARE 0.35
 
 typedef struct dense_level {
     const uint16_t *a, *b;

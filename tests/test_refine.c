@@ -518,7 +518,7 @@ void test_dense_still_pairs(void)
     home_context *ctx = context(NULL);
     int k, ok = 0, far = 0;
     if (!ctx) { CHECK(0); return; }
-    for (k = 0; k < 8; k++) {
+    for (k = 0; k < 24; k++) {
         texture t;
         synth_rng rng;
         home_result res;
