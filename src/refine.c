@@ -106,6 +106,7 @@ static int same_optimum(home_context *ctx, int slot, const double *start, int pa
     double mid[9], tolerance = 3.0 * refined->sigma_px;
     int k;
     for (k = 0; k < 9; k++) mid[k] = 0.5 * (start[k] + refined->H[k]);
+    check.refined = 0; /* set again only where this refinement converges */
     home__refine_run(ctx, slot, mid, patient, &check);
     if (tolerance < SAME_OPTIMUM_FLOOR_PX) tolerance = SAME_OPTIMUM_FLOOR_PX;
     return check.refined && corner_distance(ctx, check.H, refined->H) <= tolerance;
