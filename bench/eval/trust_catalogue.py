@@ -320,7 +320,11 @@ def still_groups(which):
 
 
 # -- consecutive frames: hand-held camera over a scene ----------------------
-VIDEO_CONDITIONS = ["day", "low_light", "motion_blur", "shake5"]
+VIDEO_CONDITIONS = ["day", "low_light", "motion_blur", "shake5", "lens_shading"]
+# lens_shading: the day frames through a lens whose illumination falls off towards the corners
+# (fixed to the sensor: it does not move with the scene), by this share at the corners, drawn
+# per sequence (uncorrected board cameras lose more; an ISP's shading correction leaves less)
+LENS_SHADING = (0.1, 0.4)
 
 
 def video_scenes(which):

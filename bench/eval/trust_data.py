@@ -16,6 +16,8 @@ Consecutive frames: video_eval.py's hand-held camera, its path slowed to about
   low_light    scenes.low_light on each frame (brightness 10-25 %, shot + read noise)
   motion_blur  each frame the mean of 7 renders over the whole frame interval
   shake5       the hand-shake jitter 5x larger
+  lens_shading day, through a lens whose illumination falls off as (r / r_corner)^2 by 10-40 %
+               at the corners (trust_catalogue.LENS_SHADING), before the sensor noise
 
 Static camera: a static background with moving textured shapes (their areas
 add up to 15-25 % of the frame; the sealed set's 13-26 %, with salted seeds:
@@ -225,6 +227,16 @@ class HandheldCamera(video_eval.Camera):
             self.amp = self.amp * 0.6
 
 
+def lens_shading(rng, falloff):
+    """Illumination of a CROP_W x CROP_H sensor through a lens: 1 at the centre, 1 - s at the
+    corners, s drawn uniformly from the range `falloff` (the (r / r_corner)^2 law)."""
+    s = rng.uniform(*falloff)
+    y, x = np.mgrid[0:CROP_H, 0:CROP_W].astype(np.float64)
+    r2 = ((x - (CROP_W - 1) / 2) ** 2 + (y - (CROP_H - 1) / 2) ** 2) / (
+        ((CROP_W - 1) / 2) ** 2 + ((CROP_H - 1) / 2) ** 2)
+    return 1.0 - s * r2
+
+
 def build_video(lib, which, quick, root, catalogue, frames, jobs=2):
     from common import parallel_map
     items = catalogue.video_scenes(which)
@@ -243,6 +255,7 @@ def build_video(lib, which, quick, root, catalogue, frames, jobs=2):
             cam = HandheldCamera(key, frames, wld.shape, 5.0 if cond == "shake5" else 1.0)
             noise = rng_for(key + "|noise")
             gain = scenes.low_light_params(rng_for(key + "|gain"))["gain"]
+            shading = lens_shading(rng_for(key + "|shading"), catalogue.LENS_SHADING)
             d.mkdir(parents=True, exist_ok=True)
             Ms = []
             for t in range(frames):
@@ -255,6 +268,8 @@ def build_video(lib, which, quick, root, catalogue, frames, jobs=2):
                                    np.linspace(-0.5, 0.5, video_eval.BLUR_SAMPLES)], axis=0)
                 else:
                     img = video_eval.render(wld, cam.M(t))
+                if cond == "lens_shading":
+                    img = img * shading
                 if cond == "low_light":
                     f = scenes.low_light(img, gain, noise)
                 else:

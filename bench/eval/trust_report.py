@@ -550,7 +550,8 @@ def write(out_dir, results, stem="trust_results", compare=None):
         L.append(f"A hand-held camera over each scene (video_eval.py's, path slowed to about "
                  f"3 px a frame), {meta['video_frames']} frames a sequence; conditions: day "
                  "(noise σ 2.5), low light, motion blur over the whole frame interval, "
-                 "5x hand shake.\n")
+                 "5x hand shake, lens shading (day frames through a lens whose illumination "
+                 "falls off by 10-40 % at the corners, fixed to the sensor).\n")
         for c in cfgs:
             L.append(f"### {CFG_LABEL[c]}\n")
             L.append(group_table(records, "video", c, sets_of["video"]) + "\n")
