@@ -26,6 +26,8 @@
 #define DENSE_STEP_EPS 0.01     /* convergence: largest corner update, level px */
 #define DENSE_HIST_BINS 256     /* |residual| histogram: 1/32 grey level per bin */
 #define DENSE_SIGMA_FLOOR 0.1   /* grey levels: coarse images average the noise away */
+#define DENSE_MAX_SHADING 1.0   /* |kappa| at most: lens shading of 1 + kappa |x|^2 (|x| = 1 at
+                                   the middle of the longer side); a fit beyond it is kept out */
 #define CLUSTER_SIDE 8          /* the covariance's blocks of pixels, finest dense level */
 #define DENSE_MAX_CLUSTERS 32   /* block columns at most (wider images share the last) */
 /* var(g) of a central difference over 2 is half a pixel's noise variance; the residual holds
@@ -46,7 +48,10 @@ typedef struct dense_solver {
     const home_context *ctx;
     double f, cx, cy;           /* normalisation, as the refinement's */
     double hn[9];               /* A -> B, normalised */
-    double alpha, beta;
+    double alpha, kappa, beta;  /* B's gain alpha (1 + kappa q) and bias; q = |x|^2 - |hn x|^2
+                                   (normalised): lens shading fixed to the sensor, 1 + kappa
+                                   |x|^2 at x, as it reaches the pixel A shows at x and B at
+                                   hn x */
     int k;                      /* parameters of the model fitted */
     double gen[8][8];           /* their generators: update dq -> W = I + sum q_i gen_i (the
                                    homography's entries h0..h7) */
@@ -126,45 +131,60 @@ static double pixel_jacobian(const dense_solver *s, const dense_level *lv, const
     return gx * gx + gy * gy;
 }
 
+/* q = |x|^2 - |x_b|^2 in normalised units: the level's pixel (x, y) of A and where it falls in
+ * B (bx, by, level px). */
+static double shading_term(const dense_solver *s, const dense_level *lv, int x, int y, double bx,
+                           double by)
+{
+    const double ua = (lv->scale * x + lv->offset - s->cx) / s->f;
+    const double va = (lv->scale * y + lv->offset - s->cy) / s->f;
+    const double ub = (lv->scale * bx + lv->offset - s->cx) / s->f;
+    const double vb = (lv->scale * by + lv->offset - s->cy) / s->f;
+    return ua * ua + va * va - ub * ub - vb * vb;
+}
+
 /* One pass over the level's interior pixels under s->hn. mode 0: the |residual| histogram;
- * 1: the weighted sums of the gain and bias fit (sums[5]); 2: the lower triangle of J^T W J
+ * 1: the weighted sums of the photometric fit (sums[9]: P^T W P, upper triangle by rows, and
+ * P^T W a, P = [B, q B, 1]); 2: the lower triangle of J^T W J
  * (jtj, k x k, row stride 8; what the solve reads), J^T W r and the sums of w and w r^2;
  * 3: the whole J^T W J, J^T W r, those sums, the gradient noise's sum w D^T D (noise), the
- * correlation's sums (corr[6] of w, w a, w b', w a^2, w b'^2, w a b') and J's weighted sums
- * against the gain's and the bias's derivatives (cross[16]: w J a, w J; the gain's taken as A,
- * which B matches at the optimum), and where the information on a shift sits (spread[2]: the
+ * correlation's sums (corr[6] of w, w a, w b', w a^2, w b'^2, w a b'), J's weighted sums
+ * against the photometric parameters' derivatives (cross[24]: w J a, w J q a, w J; B taken as
+ * A, which it matches at the optimum) and theirs (pp, 3 x 3, row stride 8), and where the information on a shift sits (spread[2]: the
  * sums of w |grad A|^2 and of its square). Returns the pixels used. */
 static int pass(const dense_solver *s, const dense_level *lv, int mode, double sigma,
                 int32_t *hist, double *sums, double *jtj, double *jtr, double *noise,
-                double *corr, double *cross, double *spread)
+                double *corr, double *cross, double *pp, double *spread)
 {
     double m[9];
     const double k = s->f / lv->scale; /* level px per normalised unit */
-    int x, y, i, j, n = 0;
+    int x, y, i, j, p, n = 0;
     level_matrix(s, lv, m);
     for (y = 1; y < lv->h - 1; y++) {
         const uint16_t *ra = lv->a + (ptrdiff_t)y * lv->w;
         const double v = (lv->scale * y + lv->offset - s->cy) / s->f;
         for (x = 1; x < lv->w - 1; x++) {
             const double a = lv->unit * ra[x], z = m[6] * x + m[7] * y + m[8];
-            double b, r, w;
-            if (!(z > 0.0) ||
-                !sample(lv, (m[0] * x + m[1] * y + m[2]) / z, (m[3] * x + m[4] * y + m[5]) / z, &b))
-                continue;
+            double bx, by, q, b, r, w;
+            if (!(z > 0.0)) continue;
+            bx = (m[0] * x + m[1] * y + m[2]) / z;
+            by = (m[3] * x + m[4] * y + m[5]) / z;
+            if (!sample(lv, bx, by, &b)) continue;
+            q = shading_term(s, lv, x, y, bx, by);
             n++;
-            r = s->alpha * b + s->beta - a;
-            if (mode == 0) {
-                int bin = (int)(fabs(r) * 32.0);
-                hist[bin < DENSE_HIST_BINS ? bin : DENSE_HIST_BINS - 1]++;
+            r = s->alpha * (1.0 + s->kappa * q) * b + s->beta - a;
+            if (mode == 0) { /* (NaN or beyond the last bin: the last bin) */
+                const double bin = fabs(r) * 32.0;
+                hist[bin < DENSE_HIST_BINS - 1 ? (int)bin : DENSE_HIST_BINS - 1]++;
                 continue;
             }
             w = cauchy_weight(r, sigma);
             if (mode == 1) {
-                sums[0] += w;
-                sums[1] += w * b;
-                sums[2] += w * a;
-                sums[3] += w * b * b;
-                sums[4] += w * a * b;
+                const double pr[3] = {b, q * b, 1.0};
+                for (i = 0, p = 0; i < 3; i++) {
+                    for (j = i; j < 3; j++) sums[p++] += w * pr[i] * pr[j];
+                    sums[6 + i] += w * pr[i] * a;
+                }
             } else {
                 double jr[8], ddx[8], ddy[8];
                 const double g2 = w * pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
@@ -180,13 +200,18 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
                 sums[0] += w;
                 sums[1] += w * r * r;
                 if (mode == 2) continue;
-                for (i = 0; i < s->k; i++) {
-                    cross[i] += w * jr[i] * a; /* J against the gain's and the bias's */
-                    cross[8 + i] += w * jr[i];
-                    for (j = 0; j < s->k; j++)
-                        noise[i * 8 + j] += w * k * k * (ddx[i] * ddx[j] + ddy[i] * ddy[j]);
+                {
+                    const double pa[3] = {a, q * a, 1.0};
+                    for (i = 0; i < s->k; i++) {
+                        for (j = 0; j < 3; j++) /* J against the photometric parameters' */
+                            cross[8 * j + i] += w * jr[i] * pa[j];
+                        for (j = 0; j < s->k; j++)
+                            noise[i * 8 + j] += w * k * k * (ddx[i] * ddx[j] + ddy[i] * ddy[j]);
+                    }
+                    for (i = 0; i < 3; i++)
+                        for (j = 0; j < 3; j++) pp[i * 8 + j] += w * pa[i] * pa[j];
                 }
-                b = s->alpha * b + s->beta;
+                b = s->alpha * (1.0 + s->kappa * q) * b + s->beta;
                 corr[0] += w;
                 corr[1] += w * a;
                 corr[2] += w * b;
@@ -217,13 +242,14 @@ static void cluster_meat(const dense_solver *s, const dense_level *lv, double si
         const double v = (lv->scale * y + lv->offset - s->cy) / s->f;
         for (x = 1; x < lv->w - 1; x++) {
             const double a = lv->unit * ra[x], z = m[6] * x + m[7] * y + m[8];
-            double b, r, w, jr[8], ddx[8], ddy[8];
+            double b, r, w, jr[8], ddx[8], ddy[8], bx, by;
             double *sc = score[x / CLUSTER_SIDE < DENSE_MAX_CLUSTERS ? x / CLUSTER_SIDE
                                                                       : DENSE_MAX_CLUSTERS - 1];
-            if (!(z > 0.0) ||
-                !sample(lv, (m[0] * x + m[1] * y + m[2]) / z, (m[3] * x + m[4] * y + m[5]) / z, &b))
-                continue;
-            r = s->alpha * b + s->beta - a;
+            if (!(z > 0.0)) continue;
+            bx = (m[0] * x + m[1] * y + m[2]) / z;
+            by = (m[3] * x + m[4] * y + m[5]) / z;
+            if (!sample(lv, bx, by, &b)) continue;
+            r = s->alpha * (1.0 + s->kappa * shading_term(s, lv, x, y, bx, by)) * b + s->beta - a;
             w = cauchy_weight(r, sigma);
             pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
             for (i = 0; i < s->k; i++) sc[i] += w * r * jr[i];
@@ -243,7 +269,7 @@ static double robust_sigma(const dense_solver *s, const dense_level *lv, int32_t
 {
     int n, i, seen = 0;
     memset(hist, 0, DENSE_HIST_BINS * sizeof *hist);
-    n = pass(s, lv, 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
+    n = pass(s, lv, 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
     for (i = 0; i < DENSE_HIST_BINS; i++) {
         seen += hist[i];
         if (2 * seen >= n) break;
@@ -308,7 +334,8 @@ static int solve_k(const double *a8, const double *b, int k, double *x)
 }
 
 typedef struct dense_fit {
-    double jtj[64], jtr[8], noise[64], corr[6], cross[16], spread[2], sum_w, sum_wr2, sigma;
+    double jtj[64], jtr[8], noise[64], corr[6], cross[24], pp[64], spread[2], sum_w, sum_wr2;
+    double sigma;
     int n;
 } dense_fit;
 
@@ -318,14 +345,19 @@ typedef struct dense_fit {
 static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int rescale, int full,
                    dense_fit *fit)
 {
-    double sums[5] = {0}, det;
+    double sums[9] = {0}, a8[64], q[3];
+    int i, j, p;
     if (rescale) fit->sigma = robust_sigma(s, lv, hist);
-    if (pass(s, lv, 1, fit->sigma, NULL, sums, NULL, NULL, NULL, NULL, NULL, NULL) < MIN_POINTS)
+    if (pass(s, lv, 1, fit->sigma, NULL, sums, NULL, NULL, NULL, NULL, NULL, NULL, NULL) <
+        MIN_POINTS)
         return 0;
-    det = sums[0] * sums[3] - sums[1] * sums[1];
-    if (det > 1e-9 * sums[0] * sums[3]) {
-        s->alpha = (sums[0] * sums[4] - sums[1] * sums[2]) / det;
-        s->beta = (sums[2] - s->alpha * sums[1]) / sums[0];
+    /* gain, shading and bias: least squares (kept as they were where singular: flat B) */
+    for (i = 0, p = 0; i < 3; i++)
+        for (j = i; j < 3; j++, p++) a8[i * 8 + j] = a8[j * 8 + i] = sums[p];
+    if (solve_k(a8, sums + 6, 3, q) && q[0] > 0.0 && fabs(q[1]) <= DENSE_MAX_SHADING * q[0]) {
+        s->alpha = q[0];
+        s->kappa = q[1] / q[0];
+        s->beta = q[2];
     }
     {
         const double sigma = fit->sigma;
@@ -335,7 +367,7 @@ static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int re
     {
         double pair[2] = {0.0, 0.0};
         fit->n = pass(s, lv, full ? 3 : 2, fit->sigma, NULL, pair, fit->jtj, fit->jtr, fit->noise,
-                      fit->corr, fit->cross, fit->spread);
+                      fit->corr, fit->cross, fit->pp, fit->spread);
         fit->sum_w = pair[0];
         fit->sum_wr2 = pair[1];
     }
@@ -538,18 +570,25 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
     resid_var = fit.sum_w > s.k ? fit.sum_wr2 / (fit.sum_w - s.k) : fit.sum_wr2;
     var_g = DENSE_GRADIENT_NOISE_SHARE * resid_var;
     for (i = 0; i < 64; i++) info[i] = fit.jtj[i] - var_g * fit.noise[i];
-    /* less what the gain and bias explain as well (a shading ramp's shift is a bias change):
-     * the Schur complement of their block, P = [A, 1], P^T W P from the correlation's sums */
+    /* less what the gain, the lens shading and the bias explain as well (a shading ramp's
+     * shift is a bias change): the Schur complement of their block, P = [A, q A, 1]:
+     * info -= C (P^T W P)^-1 C^T, C = J^T W P */
     {
-        const double *c = fit.corr, pp00 = c[3], pp01 = c[1], pp11 = c[0];
-        const double det = pp00 * pp11 - pp01 * pp01;
-        if (!(det > 0.0)) return 0;
+        double ppinv[24];
+        for (j = 0; j < 3; j++) {
+            double col[3] = {0.0, 0.0, 0.0}, x[3];
+            col[j] = 1.0;
+            if (!solve_k(fit.pp, col, 3, x)) return 0;
+            for (i = 0; i < 3; i++) ppinv[i * 8 + j] = x[i];
+        }
         for (i = 0; i < s.k; i++)
             for (j = 0; j < s.k; j++) {
-                const double ai = fit.cross[i], bi = fit.cross[8 + i];
-                const double aj = fit.cross[j], bj = fit.cross[8 + j];
-                info[i * 8 + j] -=
-                    (ai * (pp11 * aj - pp01 * bj) + bi * (pp00 * bj - pp01 * aj)) / det;
+                double v = 0.0;
+                int c, d;
+                for (c = 0; c < 3; c++)
+                    for (d = 0; d < 3; d++)
+                        v += fit.cross[8 * c + i] * ppinv[c * 8 + d] * fit.cross[8 * d + j];
+                info[i * 8 + j] -= v;
             }
     }
     /* in the homography's entries (h8 = 1): dh = B dq, B's columns the derivatives of
@@ -605,7 +644,7 @@ int home__refine_dense(home_context *ctx, int slot, home_result *result, double 
         int in = 0, n;
         result->refine_zncc = va > 0.0 && vb > 0.0 ? cab / sqrt(va * vb) : 0.0;
         memset(hist, 0, DENSE_HIST_BINS * sizeof *hist);
-        n = pass(&s, &lv[0], 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
+        n = pass(&s, &lv[0], 0, 0.0, hist, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
         for (i = 0; i < DENSE_HIST_BINS && i < within; i++) in += hist[i];
         result->refine_inlier_share = n ? (double)in / n : 0.0;
     }
