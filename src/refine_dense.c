@@ -8,9 +8,11 @@
  * with a small predicted error) on the two slots' background16 images (quarter size, at most
  * HOME__BACKGROUND_PIXELS, in sixteenths of a grey level) and two 2x2 means of them, coarse to
  * fine from the coarsest image's best whole-pixel shift, every interior pixel a template
- * point; a gain and bias and Cauchy weights as in the refinement. The predicted error comes
- * from J^T W J without the apparent information of the template's gradient noise and of what
- * the gain and bias explain, through the same model selection as the refinement's: the larger
+ * point; a gain and bias and Cauchy weights as in the refinement, and a lens's shading: a
+ * falloff 1 + kappa |x|^2 fixed to the sensor, which a still pattern the scene does not share
+ * would otherwise pull towards no motion. The predicted error comes from J^T W J without the
+ * apparent information of the template's gradient noise and of what the gain, shading and bias
+ * explain, through the same model selection as the refinement's: the larger
  * of its homoscedastic prediction and the sandwich with the scores summed over blocks of
  * pixels (residuals that are not independent: an edge the motion model does not quite fit,
  * blur that differs between frames). */
@@ -340,7 +342,7 @@ typedef struct dense_fit {
 } dense_fit;
 
 /* One Gauss-Newton iteration at the level: the residuals' scale (rescale: anew, else
- * fit->sigma's), gain and bias, then the normal equations (into fit; full: with the
+ * fit->sigma's), gain, shading and bias, then the normal equations (into fit; full: with the
  * statistics of the estimate's prediction, pass() mode 3). 0 when too few pixels overlap. */
 static int iterate(dense_solver *s, const dense_level *lv, int32_t *hist, int rescale, int full,
                    dense_fit *fit)
