@@ -28,8 +28,9 @@
 #define DENSE_STEP_EPS 0.01     /* convergence: largest corner update, level px */
 #define DENSE_HIST_BINS 256     /* |residual| histogram: 1/32 grey level per bin */
 #define DENSE_SIGMA_FLOOR 0.1   /* grey levels: coarse images average the noise away */
-#define DENSE_MAX_SHADING 1.0   /* |kappa| at most: lens shading of 1 + kappa |x|^2 (|x| = 1 at
-                                   the middle of the longer side); a fit beyond it is kept out */
+#define DENSE_MAX_SHADING 1.0   /* |kappa| at most: lens shading of 1 + kappa |x|^2 (|x| = 1 half
+                                   the longer side from the centre); a fit beyond it is not
+                                   taken */
 #define CLUSTER_SIDE 8          /* the covariance's blocks of pixels, finest dense level */
 #define DENSE_MAX_CLUSTERS 32   /* block columns at most (wider images share the last) */
 /* var(g) of a central difference over 2 is half a pixel's noise variance; the residual holds
@@ -152,8 +153,9 @@ static double shading_term(const dense_solver *s, const dense_level *lv, int x, 
  * 3: the whole J^T W J, J^T W r, those sums, the gradient noise's sum w D^T D (noise), the
  * correlation's sums (corr[6] of w, w a, w b', w a^2, w b'^2, w a b'), J's weighted sums
  * against the photometric parameters' derivatives (cross[24]: w J a, w J q a, w J; B taken as
- * A, which it matches at the optimum) and theirs (pp, 3 x 3, row stride 8), and where the information on a shift sits (spread[2]: the
- * sums of w |grad A|^2 and of its square). Returns the pixels used. */
+ * A, which it matches at the optimum) and theirs (pp, 3 x 3, row stride 8), and where the
+ * information on a shift sits (spread[2]: the sums of w |grad A|^2 and of its square).
+ * Returns the pixels used. */
 static int pass(const dense_solver *s, const dense_level *lv, int mode, double sigma,
                 int32_t *hist, double *sums, double *jtj, double *jtr, double *noise,
                 double *corr, double *cross, double *pp, double *spread)
