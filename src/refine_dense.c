@@ -134,16 +134,30 @@ static double pixel_jacobian(const dense_solver *s, const dense_level *lv, const
     return gx * gx + gy * gy;
 }
 
-/* q = |x|^2 - |x_b|^2 in normalised units: the level's pixel (x, y) of A and where it falls in
- * B (bx, by, level px). */
-static double shading_term(const dense_solver *s, const dense_level *lv, int x, int y, double bx,
-                           double by)
+/* The level's pixel (x, y) of A in B under m (level_matrix()): B's bilinear sample there (b)
+ * and the lens shading term q = |x|^2 - |x_b|^2 in normalised units; 0 where it falls outside
+ * B. */
+static int warped(const dense_solver *s, const dense_level *lv, const double *m, int x, int y,
+                  double *b, double *q)
 {
-    const double ua = (lv->scale * x + lv->offset - s->cx) / s->f;
-    const double va = (lv->scale * y + lv->offset - s->cy) / s->f;
-    const double ub = (lv->scale * bx + lv->offset - s->cx) / s->f;
-    const double vb = (lv->scale * by + lv->offset - s->cy) / s->f;
-    return ua * ua + va * va - ub * ub - vb * vb;
+    const double z = m[6] * x + m[7] * y + m[8];
+    double bx, by, ua, va, ub, vb;
+    if (!(z > 0.0)) return 0;
+    bx = (m[0] * x + m[1] * y + m[2]) / z;
+    by = (m[3] * x + m[4] * y + m[5]) / z;
+    if (!sample(lv, bx, by, b)) return 0;
+    ua = (lv->scale * x + lv->offset - s->cx) / s->f;
+    va = (lv->scale * y + lv->offset - s->cy) / s->f;
+    ub = (lv->scale * bx + lv->offset - s->cx) / s->f;
+    vb = (lv->scale * by + lv->offset - s->cy) / s->f;
+    *q = ua * ua + va * va - ub * ub - vb * vb;
+    return 1;
+}
+
+/* B's sample b as the model predicts A there: gain, lens shading (q: warped()) and bias. */
+static double predicted(const dense_solver *s, double b, double q)
+{
+    return s->alpha * (1.0 + s->kappa * q) * b + s->beta;
 }
 
 /* One pass over the level's interior pixels under s->hn. mode 0: the |residual| histogram;
@@ -168,15 +182,11 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
         const uint16_t *ra = lv->a + (ptrdiff_t)y * lv->w;
         const double v = (lv->scale * y + lv->offset - s->cy) / s->f;
         for (x = 1; x < lv->w - 1; x++) {
-            const double a = lv->unit * ra[x], z = m[6] * x + m[7] * y + m[8];
-            double bx, by, q, b, r, w;
-            if (!(z > 0.0)) continue;
-            bx = (m[0] * x + m[1] * y + m[2]) / z;
-            by = (m[3] * x + m[4] * y + m[5]) / z;
-            if (!sample(lv, bx, by, &b)) continue;
-            q = shading_term(s, lv, x, y, bx, by);
+            const double a = lv->unit * ra[x];
+            double q, b, r, w;
+            if (!warped(s, lv, m, x, y, &b, &q)) continue;
             n++;
-            r = s->alpha * (1.0 + s->kappa * q) * b + s->beta - a;
+            r = predicted(s, b, q) - a;
             if (mode == 0) { /* (NaN or beyond the last bin: the last bin) */
                 const double bin = fabs(r) * 32.0;
                 hist[bin < DENSE_HIST_BINS - 1 ? (int)bin : DENSE_HIST_BINS - 1]++;
@@ -215,7 +225,7 @@ static int pass(const dense_solver *s, const dense_level *lv, int mode, double s
                     for (i = 0; i < 3; i++)
                         for (j = 0; j < 3; j++) pp[i * 8 + j] += w * pa[i] * pa[j];
                 }
-                b = s->alpha * (1.0 + s->kappa * q) * b + s->beta;
+                b = predicted(s, b, q);
                 corr[0] += w;
                 corr[1] += w * a;
                 corr[2] += w * b;
@@ -245,15 +255,12 @@ static void cluster_meat(const dense_solver *s, const dense_level *lv, double si
         const uint16_t *ra = lv->a + (ptrdiff_t)y * lv->w;
         const double v = (lv->scale * y + lv->offset - s->cy) / s->f;
         for (x = 1; x < lv->w - 1; x++) {
-            const double a = lv->unit * ra[x], z = m[6] * x + m[7] * y + m[8];
-            double b, r, w, jr[8], ddx[8], ddy[8], bx, by;
+            const double a = lv->unit * ra[x];
+            double b, q, r, w, jr[8], ddx[8], ddy[8];
             double *sc = score[x / CLUSTER_SIDE < DENSE_MAX_CLUSTERS ? x / CLUSTER_SIDE
                                                                       : DENSE_MAX_CLUSTERS - 1];
-            if (!(z > 0.0)) continue;
-            bx = (m[0] * x + m[1] * y + m[2]) / z;
-            by = (m[3] * x + m[4] * y + m[5]) / z;
-            if (!sample(lv, bx, by, &b)) continue;
-            r = s->alpha * (1.0 + s->kappa * shading_term(s, lv, x, y, bx, by)) * b + s->beta - a;
+            if (!warped(s, lv, m, x, y, &b, &q)) continue;
+            r = predicted(s, b, q) - a;
             w = cauchy_weight(r, sigma);
             pixel_jacobian(s, lv, ra, x, v, jr, ddx, ddy);
             for (i = 0; i < s->k; i++) sc[i] += w * r * jr[i];
