@@ -14,7 +14,10 @@
  * holds however fine the background's detail. evidence is expected over the spread of its
  * per-pixel terms: how much of the frame it rests on (a few edge pixels next to the mask
  * decide nothing). Gain and bias (exposure) are projected out; residuals far from the median
- * (occlusion) and clipped pixels are left out. */
+ * (occlusion) and clipped pixels are left out. Lens shading stays with the sensor, so r never
+ * holds it while p and the predictions hold its change under h: where the caller allows it and
+ * p shows a falloff towards the corners, that change is projected out too (else a camera moving
+ * over a plain wall through a vignetting lens looks still). */
 #include "refine_internal.h"
 #include <math.h>
 #include <string.h>
@@ -32,6 +35,10 @@
 #define SCREEN_STEP 4       /* the screening pass: every fourth row, */
 #define SCREEN_EVIDENCE 5.0 /* ... the motion's expected score and evidence there this large, */
 #define SCREEN_SHARE 0.667  /* ... and this share of it observed: the background moves */
+#define SHADING_MIN_SHARE 1e-6 /* Z projected out where this share of it is not [1, A], */
+#define SHADING_MIN_FALLOFF 0.02 /* ... and p holds a falloff of at least this at the corners (a
+                                    brightening there is no lens's; tuning set: lens-shaded
+                                    frames 0.13-0.44, the raw fog clip's objects -0.02-0) */
 
 /* The background of A and B in sixteenths smoothed by the 5-tap binomial (sigma 1 px) in both
  * directions, edges replicated. Rows, then columns in place with the interior apart from the
@@ -201,24 +208,38 @@ static void row_span(const double *m, int w, int h, int y, int *lo, int *hi)
     *hi = (int)r;
 }
 
-/* Sums over the background pixels for inner products with [1, A] projected out. */
+/* Sums over the background pixels for inner products with [1, A, Z] projected out: Z is the
+ * change lens shading makes under h (below). */
 enum { V_R, V_P, V_PA, V_PB, V_QA, V_QB, V_GX, V_GY, N_V };
 typedef struct score_sums {
-    double n, a, aa;
-    double s[N_V], sa[N_V];         /* sum of v, of v * A */
+    double n, a, aa, z, zz, az;
+    double s[N_V], sa[N_V], sz[N_V]; /* sum of v, of v * A, of v * Z */
     double rr, rp, pp, qapb, qbpa;  /* the inner products used */
     double xx, xy, yy, rx, ry;      /* ... those of the background's own translation, */
     double dd;                      /* and h's squared displacements */
     double e, ee;                   /* the expected's terms: sum, sum of squares */
+    int shading;                    /* Z projected out */
 } score_sums;
 
-/* <u, v> with the constant and A projected out */
+/* <u, v> with the constant, A and Z projected out (Z only where it is not (nearly) a
+ * combination of the others: h close to the identity) */
 static double projected(const score_sums *k, double uv, int u, int v)
 {
     const double det = k->n * k->aa - k->a * k->a;
+    const double g[9] = {k->n, k->a, k->z, k->a, k->aa, k->az, k->z, k->az, k->zz};
+    const double su[3] = {k->s[u], k->sa[u], k->sz[u]}, sv[3] = {k->s[v], k->sa[v], k->sz[v]};
+    double c[9], det3;
+    int i, j;
     if (!(det > 0.0)) return uv - k->s[u] * k->s[v] / k->n;
-    return uv - (k->s[u] * (k->aa * k->s[v] - k->a * k->sa[v]) +
-                 k->sa[u] * (k->n * k->sa[v] - k->a * k->s[v])) / det;
+    home__cofactors3(g, c);
+    det3 = g[0] * c[0] + g[1] * c[1] + g[2] * c[2];
+    /* Z's part beyond [1, A] (det3 / det) against its size */
+    if (!k->shading || !(det3 > SHADING_MIN_SHARE * det * k->zz))
+        return uv - (k->s[u] * (k->aa * k->s[v] - k->a * k->sa[v]) +
+                     k->sa[u] * (k->n * k->sa[v] - k->a * k->s[v])) / det;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) uv -= su[i] * c[3 * j + i] * sv[j] / det3;
+    return uv;
 }
 
 /* The background pixels (mask) both h (m, background pixels) and its inverse (m_inv) keep
@@ -289,6 +310,7 @@ static void accumulate(const home__refine_state *st, const uint16_t *a, const ui
 {
     const int w = st->background_w, hh = st->background_h;
     const uint8_t *mask = st->flat;
+    const double cx = 0.5 * (w - 1), cy = 0.5 * (hh - 1), inv_r2 = 1.0 / (cx * cx + cy * cy);
     int x, y, j;
     for (y = first; y < hh - BORDER; y += step) {
         /* both maps along the row: numerators and denominators linear in x */
@@ -298,7 +320,7 @@ static void accumulate(const home__refine_state *st, const uint16_t *a, const ui
         for (x = next_set(mask + (ptrdiff_t)y * w, BORDER, w - BORDER); x < w - BORDER;
              x = next_set(mask + (ptrdiff_t)y * w, x + 1, w - BORDER)) {
             const ptrdiff_t p = (ptrdiff_t)y * w + x;
-            double dx, dy, v[N_V], av, ua, va, ub, vb, inv;
+            double dx, dy, v[N_V], av, zv, ua, va, ub, vb, inv;
             v[V_R] = (int)b[p] - (int)a[p];
             if (v[V_R] < lo || v[V_R] > hi) continue;
             inv = 1.0 / (m[6] * x + db);
@@ -325,12 +347,20 @@ static void accumulate(const home__refine_state *st, const uint16_t *a, const ui
             v[V_GX] = 0.25 * ((sa[p + 1] - sa[p - 1]) + (sb[p + 1] - sb[p - 1]));
             v[V_GY] = 0.25 * ((sa[p + w] - sa[p - w]) + (sb[p + w] - sb[p - w]));
             av = a[p];
+            /* lens shading stays with the sensor: a falloff s = 1 - kappa rho^2 (rho from the
+             * centre) changes r under h by about kappa A (rho^2(x + d) - rho^2(x)), which p and
+             * the predictions hold and r does not */
+            zv = av * ((x - cx) * dx + (y - cy) * dy) * inv_r2;
             k->n += 1.0;
             k->a += av;
             k->aa += av * av;
+            k->z += zv;
+            k->zz += zv * zv;
+            k->az += av * zv;
             for (j = 0; j < N_V; j++) {
                 k->s[j] += v[j];
                 k->sa[j] += v[j] * av;
+                k->sz[j] += v[j] * zv;
             }
             k->rr += v[V_R] * v[V_R];
             k->rp += v[V_R] * v[V_P];
@@ -352,11 +382,26 @@ static void accumulate(const home__refine_state *st, const uint16_t *a, const ui
     }
 }
 
+/* The falloff kappa (s = 1 - kappa rho^2) that p's Z part beyond [1, A] implies: p = -grad A . d
+ * holds 2 kappa Z of it */
+static double shading_falloff(const score_sums *k)
+{
+    const double det = k->n * k->aa - k->a * k->a;
+    double pz = k->sz[V_P], zz = k->zz;
+    if (det > 0.0) {
+        pz -= (k->s[V_P] * (k->aa * k->z - k->a * k->az) +
+               k->sa[V_P] * (k->n * k->az - k->a * k->z)) / det;
+        zz -= (k->z * (k->aa * k->z - k->a * k->az) + k->az * (k->n * k->az - k->a * k->z)) / det;
+    }
+    return zz > 0.0 ? 0.5 * pz / zz : 0.0;
+}
+
 /* k into the test's statistics (home__refine_background_score's); 0 when they are undefined */
-static int finish(const score_sums *k, double *observed, double *expected, double *evidence,
+static int finish(score_sums *k, double *observed, double *expected, double *evidence,
                   double *own_motion)
 {
     double e_raw, spread, sigma2, norm, rp, pp, rr;
+    k->shading = k->shading && shading_falloff(k) >= SHADING_MIN_FALLOFF;
     rp = projected(k, k->rp, V_R, V_P);
     pp = projected(k, k->pp, V_P, V_P);
     rr = projected(k, k->rr, V_R, V_R);
@@ -384,8 +429,8 @@ static int finish(const score_sums *k, double *observed, double *expected, doubl
 }
 
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
-                                  const double *h, double *observed, double *expected,
-                                  double *evidence, double *own_motion)
+                                  const double *h, int shading, double *observed,
+                                  double *expected, double *evidence, double *own_motion)
 {
     const home__refine_state *st = &ctx->refine;
     const int w = st->background_w, hh = st->background_h;
@@ -400,6 +445,7 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
     smooth(a, w, hh, sa);
     smooth(b, w, hh, sb);
     memset(&k, 0, sizeof k);
+    k.shading = shading;
     /* every SCREEN_STEP-th row first: a background that already shows most of the motion
      * there, on evidence of its own, moves (the full test could only agree but by chance) */
     accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, BORDER, SCREEN_STEP, &k);
@@ -408,6 +454,7 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
         *expected >= SCREEN_EVIDENCE && *evidence >= SCREEN_EVIDENCE &&
         *observed >= SCREEN_SHARE * *expected)
         return 1;
+    k.shading = shading;
     for (first = BORDER + 1; first < BORDER + SCREEN_STEP; first++)
         accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, first, SCREEN_STEP, &k);
     *observed = *expected = *evidence = *own_motion = 0.0;

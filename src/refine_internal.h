@@ -169,11 +169,12 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
  * displacement there (about 0 if it stands still, below 1 if a part of it moves with h, large
  * if it moves otherwise). Every fourth row is tested first: where the background there
  * already shows the motion (observed at least two thirds of expected, both expected and
- * evidence at least 5), those rows' statistics are returned. Returns 0 (all 0) when there is
- * too little background or no refinement. Uses the match-time scratch. */
+ * evidence at least 5), those rows' statistics are returned. shading: lens shading may explain
+ * what the motion changes (a falloff fixed to the sensor; see the file). Returns 0 (all 0)
+ * when there is too little background or no refinement. Uses the match-time scratch. */
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
-                                  const double *h, double *observed, double *expected,
-                                  double *evidence, double *own_motion);
+                                  const double *h, int shading, double *observed,
+                                  double *expected, double *evidence, double *own_motion);
 
 /* refine_dense.c: frames A (slot) and B aligned from the identity with every pixel of their
  * background16 images and two 2x2 means of them, in the most general model cfg.max_model
