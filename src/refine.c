@@ -181,19 +181,18 @@ static int background_refutes(home_context *ctx, int slot, const home_result *tr
                               double *own_motion)
 {
     home__refine_state *st = &ctx->refine;
-    double *sc = st->score, shaded[3], shaded_own;
+    double stats[4], shaded[4];
+    const int similarity = trial->model <= HOME_MODEL_SIMILARITY;
     st->scored = home__refine_background_score(ctx, st->background16[slot],
-                                               st->background16[st->next_slot ^ 1], trial->H, 0,
-                                               &sc[0], &sc[1], &sc[2], own_motion);
-    if (!st->scored || !home__refine_score_refutes(sc[0], sc[1], sc[2])) return 0;
-    if (trial->model <= HOME_MODEL_SIMILARITY &&
-        home__refine_background_score(ctx, st->background16[slot],
-                                      st->background16[st->next_slot ^ 1], trial->H, 1,
-                                      &shaded[0], &shaded[1], &shaded[2], &shaded_own) &&
-        shaded[1] >= BACKGROUND_EVIDENCE && shaded[2] >= BACKGROUND_EVIDENCE &&
+                                               st->background16[st->next_slot ^ 1], trial->H,
+                                               stats, similarity ? shaded : NULL);
+    memcpy(st->score, stats, sizeof st->score);
+    *own_motion = stats[3];
+    if (!st->scored || !home__refine_score_refutes(stats[0], stats[1], stats[2])) return 0;
+    if (similarity && shaded[1] >= BACKGROUND_EVIDENCE && shaded[2] >= BACKGROUND_EVIDENCE &&
         shaded[0] >= shaded[1] / 3.0) {
-        memcpy(sc, shaded, sizeof shaded);
-        *own_motion = shaded_own;
+        memcpy(st->score, shaded, sizeof st->score);
+        *own_motion = shaded[3];
         return 0;
     }
     return 1;

@@ -221,6 +221,15 @@ typedef struct score_sums {
     int shading;                    /* Z projected out */
 } score_sums;
 
+/* <u, v> with the constant and A projected out, from the sums of u, u A, v, v A (n A A - (sum
+ * A)^2 > 0) */
+static double without_constant_and_a(const score_sums *k, double uv, double su, double sua,
+                                     double sv, double sva)
+{
+    const double det = k->n * k->aa - k->a * k->a;
+    return uv - (su * (k->aa * sv - k->a * sva) + sua * (k->n * sva - k->a * sv)) / det;
+}
+
 /* <u, v> with the constant, A and Z projected out (Z only where it is not (nearly) a
  * combination of the others: h close to the identity) */
 static double projected(const score_sums *k, double uv, int u, int v)
@@ -235,8 +244,7 @@ static double projected(const score_sums *k, double uv, int u, int v)
     det3 = g[0] * c[0] + g[1] * c[1] + g[2] * c[2];
     /* Z's part beyond [1, A] (det3 / det) against its size */
     if (!k->shading || !(det3 > SHADING_MIN_SHARE * det * k->zz))
-        return uv - (k->s[u] * (k->aa * k->s[v] - k->a * k->sa[v]) +
-                     k->sa[u] * (k->n * k->sa[v] - k->a * k->s[v])) / det;
+        return without_constant_and_a(k, uv, k->s[u], k->sa[u], k->s[v], k->sa[v]);
     for (i = 0; i < 3; i++)
         for (j = 0; j < 3; j++) uv -= su[i] * c[3 * j + i] * sv[j] / det3;
     return uv;
@@ -386,12 +394,10 @@ static void accumulate(const home__refine_state *st, const uint16_t *a, const ui
  * holds 2 kappa Z of it */
 static double shading_falloff(const score_sums *k)
 {
-    const double det = k->n * k->aa - k->a * k->a;
     double pz = k->sz[V_P], zz = k->zz;
-    if (det > 0.0) {
-        pz -= (k->s[V_P] * (k->aa * k->z - k->a * k->az) +
-               k->sa[V_P] * (k->n * k->az - k->a * k->z)) / det;
-        zz -= (k->z * (k->aa * k->z - k->a * k->az) + k->az * (k->n * k->az - k->a * k->z)) / det;
+    if (k->n * k->aa - k->a * k->a > 0.0) {
+        pz = without_constant_and_a(k, pz, k->s[V_P], k->sa[V_P], k->z, k->az);
+        zz = without_constant_and_a(k, zz, k->z, k->az, k->z, k->az);
     }
     return zz > 0.0 ? 0.5 * pz / zz : 0.0;
 }
@@ -428,36 +434,54 @@ static int finish(score_sums *k, double *observed, double *expected, double *evi
     return 1;
 }
 
+/* finish() of a copy of k, with or without the falloff's change projected out, into
+ * stats[4] (observed, expected, evidence, own motion; all 0 where undefined). */
+static int finish_as(const score_sums *k, int shading, double *stats)
+{
+    score_sums t = *k;
+    t.shading = shading;
+    if (finish(&t, &stats[0], &stats[1], &stats[2], &stats[3])) return 1;
+    memset(stats, 0, 4 * sizeof *stats);
+    return 0;
+}
+
+/* The screening pass's verdict: the background already shows most of the motion there. */
+static int screen_moves(const double *stats)
+{
+    return stats[1] >= SCREEN_EVIDENCE && stats[2] >= SCREEN_EVIDENCE &&
+           stats[0] >= SCREEN_SHARE * stats[1];
+}
+
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
-                                  const double *h, int shading, double *observed,
-                                  double *expected, double *evidence, double *own_motion)
+                                  const double *h, double *stats, double *shaded)
 {
     const home__refine_state *st = &ctx->refine;
     const int w = st->background_w, hh = st->background_h;
     int16_t *sa = st->sampled, *sb = st->smoothed_b;
-    int first;
+    int first, shaded_screened = 0;
     double m[9], m_inv[9], median, mad, lo, hi;
     score_sums k;
-    *observed = *expected = *evidence = *own_motion = 0.0;
+    memset(stats, 0, 4 * sizeof *stats);
+    if (shaded) memset(shaded, 0, 4 * sizeof *shaded);
     if (!prepare(st, a, b, h, m, m_inv, &median, &mad)) return 0;
     lo = median - REJECT_SIGMAS * mad;
     hi = median + REJECT_SIGMAS * mad;
     smooth(a, w, hh, sa);
     smooth(b, w, hh, sb);
     memset(&k, 0, sizeof k);
-    k.shading = shading;
     /* every SCREEN_STEP-th row first: a background that already shows most of the motion
-     * there, on evidence of its own, moves (the full test could only agree but by chance) */
+     * there, on evidence of its own, moves (the full test could only agree but by chance);
+     * the same sums serve both tests */
     accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, BORDER, SCREEN_STEP, &k);
-    if (k.n * MIN_SHARE * SCREEN_STEP >= (double)w * hh &&
-        finish(&k, observed, expected, evidence, own_motion) &&
-        *expected >= SCREEN_EVIDENCE && *evidence >= SCREEN_EVIDENCE &&
-        *observed >= SCREEN_SHARE * *expected)
-        return 1;
-    k.shading = shading;
+    if (k.n * MIN_SHARE * SCREEN_STEP >= (double)w * hh) {
+        if (shaded) shaded_screened = finish_as(&k, 1, shaded) && screen_moves(shaded);
+        if (finish_as(&k, 0, stats) && screen_moves(stats)) return 1;
+    }
     for (first = BORDER + 1; first < BORDER + SCREEN_STEP; first++)
         accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, first, SCREEN_STEP, &k);
-    *observed = *expected = *evidence = *own_motion = 0.0;
+    memset(stats, 0, 4 * sizeof *stats);
+    if (shaded && !shaded_screened) memset(shaded, 0, 4 * sizeof *shaded);
     if (k.n * MIN_SHARE < (double)w * hh) return 0;
-    return finish(&k, observed, expected, evidence, own_motion);
+    if (shaded && !shaded_screened) finish_as(&k, 1, shaded);
+    return finish_as(&k, 0, stats);
 }

@@ -161,20 +161,20 @@ int home__refine_plain_regions(const home_context *ctx, int slot);
 double home__refine_plain_background(home_context *ctx, int slot, const double *h);
 
 /* refine_background.c: the score test of h (pixels, A -> B) on the fine backgrounds a and b
- * (background16 images: refine.background_w x background_h) at the pixels away from texture.
- * observed: the identity's residual projected on the one h predicts, over its noise (about
- * N(0, 1) if the background stands still); expected: the same if h were the background's
- * motion; evidence: expected over the spread of its per-pixel terms; own_motion: the
- * translation the background shows by itself (least squares on its gradient) over h's RMS
+ * (background16 images: refine.background_w x background_h) at the pixels away from texture,
+ * into stats[4]: observed, the identity's residual projected on the one h predicts, over its
+ * noise (about N(0, 1) if the background stands still); expected, the same if h were the
+ * background's motion; evidence, expected over the spread of its per-pixel terms; own motion,
+ * the translation the background shows by itself (least squares on its gradient) over h's RMS
  * displacement there (about 0 if it stands still, below 1 if a part of it moves with h, large
  * if it moves otherwise). Every fourth row is tested first: where the background there
  * already shows the motion (observed at least two thirds of expected, both expected and
- * evidence at least 5), those rows' statistics are returned. shading: lens shading may explain
- * what the motion changes (a falloff fixed to the sensor; see the file). Returns 0 (all 0)
- * when there is too little background or no refinement. Uses the match-time scratch. */
+ * evidence at least 5), those rows' statistics are returned. shaded (NULL: not wanted): the
+ * same from the same sums with a lens falloff's change under h projected out (see the file),
+ * screened alike. Returns 0 (stats all 0) when there is too little background or no
+ * refinement. Uses the match-time scratch. */
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
-                                  const double *h, int shading, double *observed,
-                                  double *expected, double *evidence, double *own_motion);
+                                  const double *h, double *stats, double *shaded);
 
 /* refine_dense.c: frames A (slot) and B aligned from the identity with every pixel of their
  * background16 images and two 2x2 means of them, in the most general model cfg.max_model
