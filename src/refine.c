@@ -168,34 +168,46 @@ int home__refine_score_refutes(double observed, double expected, double evidence
 
 /* Does the background refute h (the score test; kept for home__refine_last_score())? A lens
  * falloff fixed to the sensor stands still whatever the camera does, so on a plain background
- * it refutes every motion: a motion of at most a similarity the test refutes is tested again
- * with the falloff's change projected out, and stands when the background then shows it
- * (expected and evidence at least BACKGROUND_EVIDENCE, at least a third of it observed). Not
- * refuted is not enough there: with the falloff taken out, the faint background of a still
- * camera may show nothing either way, and textured objects moving over it would pass (a static
- * fog clip seen through a 15 % falloff: 31 of 100 similarity answers more than 2 px off). Not for
- * a homography or an affine motion: the template points' refinement has no shading term, and
- * those bend to a falloff (tuning set, where a falloff merely did not refute them: answers
- * 0.8-1.5 px off at a predicted 0.25-0.35 px; a few-edges pair 5.4 px off at 0.56 px). */
-static int background_refutes(home_context *ctx, int slot, const home_result *trial,
+ * it refutes every motion: a motion the test refutes is tested again with the falloff's change
+ * projected out, and stands when the background then shows it (expected and evidence at least
+ * BACKGROUND_EVIDENCE, at least a third of it observed). Not refuted is not enough there: with
+ * the falloff taken out, the faint background of a still camera may show nothing either way,
+ * and textured objects moving over it would pass (a static fog clip seen through a 15 % falloff:
+ * 31 of 100 similarity answers more than 2 px off). The motion that stands is refined again
+ * with the falloff fitted beside it (trial is updated); a homography or an affine motion only
+ * when that refinement is accepted: refined without the falloff, those bend to it (tuning set,
+ * where a falloff merely did not refute them: answers 0.8-1.5 px off at a predicted
+ * 0.25-0.35 px; a few-edges pair 5.4 px off at 0.56 px). */
+static int background_refutes(home_context *ctx, int slot, home_result *trial,
                               double *own_motion)
 {
     home__refine_state *st = &ctx->refine;
     double stats[4], shaded[4];
     const int similarity = trial->model <= HOME_MODEL_SIMILARITY;
+    home_result fit;
     st->scored = home__refine_background_score(ctx, st->background16[slot],
                                                st->background16[st->next_slot ^ 1], trial->H,
-                                               stats, similarity ? shaded : NULL);
+                                               stats, shaded);
     memcpy(st->score, stats, sizeof st->score);
     *own_motion = stats[3];
     if (!st->scored || !home__refine_score_refutes(stats[0], stats[1], stats[2])) return 0;
-    if (similarity && shaded[1] >= BACKGROUND_EVIDENCE && shaded[2] >= BACKGROUND_EVIDENCE &&
-        shaded[0] >= shaded[1] / 3.0) {
-        memcpy(st->score, shaded, sizeof st->score);
-        *own_motion = shaded[3];
-        return 0;
+    if (!(shaded[1] >= BACKGROUND_EVIDENCE && shaded[2] >= BACKGROUND_EVIDENCE &&
+          shaded[0] >= shaded[1] / 3.0))
+        return 1;
+    /* the falloff is in the frames: the motion refined again with it */
+    fit = *trial;
+    home__refine_run_shaded(ctx, slot, trial->H, &fit);
+    if (!similarity && fit.refine_status != HOME_REFINE_ACCEPTED) return 1;
+    memcpy(st->score, shaded, sizeof st->score);
+    *own_motion = shaded[3];
+    if (fit.refine_status == HOME_REFINE_ACCEPTED) {
+        memcpy(trial->H, fit.H, sizeof trial->H);
+        trial->model = fit.model;
+        trial->sigma_px = fit.sigma_px;
+        trial->ok = trial->sigma_px <= ctx->cfg.max_sigma_px;
+        trial->failure = trial->ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
     }
-    return 1;
+    return 0;
 }
 
 /* Does a refined estimate vouch for itself? A predicted error within VOUCH_SIGMA_SHARE of

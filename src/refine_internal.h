@@ -51,6 +51,10 @@ typedef struct home__refine_solver {
     int mask_level;                     /* the level img_b2 holds the points' mask for */
     double signal_share;                /* the share of the finest J^T W J that is the
                                            frames' information, where its slow steps tell */
+    int shading;                        /* fit a lens falloff fixed to the sensor too */
+    double kappa;                       /* ... its depth s = 1 - kappa rho^2 (0 at the start) */
+    double rho_scale;                   /* rho^2 = rho_scale |(u, v)|^2 in normalised units:
+                                           1 at the frame's corners */
 } home__refine_solver;
 
 extern const double home__refine_identity[9];
@@ -123,6 +127,9 @@ double home__refine_max_corner_distance(double cx, double cy, const double *h1,
  * entry is h0's); else 0. */
 double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
                         home_result *result);
+/* The same (patient), fitting beside the motion a lens falloff fixed to the sensor,
+ * s = 1 - kappa rho^2 (rho^2 = 1 at the corners): frames whose background shows one. */
+void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, home_result *result);
 /* The same without the points of the regions excluded flags (the identity test's grid): the
  * motion of the rest of the frame. */
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,

@@ -227,6 +227,127 @@ static int is_excluded(const home__refine_solver *s, const home__refine_points *
     return s->excluded[region_of(tp->x[i], tp->y[i], s->st->w[level], s->st->h[level])] != 0;
 }
 
+/* Lens shading fixed to the sensor, s(x) = 1 - kappa rho^2(x): frame B's sample at h(x) is
+ * s(h(x)) times the scene, A's at x s(x) times it, so B's samples times s(x) / s(h(x)) compare
+ * with A. rho^2 of a template point (u, v) and of its image under hn, normalised units. */
+#define KAPPA_MIN (-0.5) /* the falloff fitted stays within these: a brightening towards the */
+#define KAPPA_MAX 0.8    /* corners of half, a darkening of four fifths */
+
+static void shading_radii(const home__refine_solver *s, const double *h, double u, double v,
+                          double *ra, double *rb)
+{
+    const double w = h[6] * u + h[7] * v + h[8];
+    const double x = (h[0] * u + h[1] * v + h[2]) / w, y = (h[3] * u + h[4] * v + h[5]) / w;
+    *ra = s->rho_scale * (u * u + v * v);
+    *rb = s->rho_scale * (x * x + y * y);
+}
+
+/* B's samples img_b at `level`'s points under hn times s(x) / s(h(x)) at the current kappa. */
+static void shade_samples(const home__refine_solver *s, int level, const double *hn, float *img_b)
+{
+    const home__refine_points *tp = &s->tpl[level];
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const float aff[3] = {(float)(sc / s->f), (float)((o - s->cx) / s->f),
+                          (float)((o - s->cy) / s->f)};
+    int i;
+    if (s->kappa == 0.0) return;
+    for (i = 0; i < tp->n; i++) {
+        double ra, rb;
+        if (img_b[i] < 0.0f) continue;
+        shading_radii(s, hn, (double)(aff[0] * (float)tp->x[i] + aff[1]),
+                      (double)(aff[0] * (float)tp->y[i] + aff[2]), &ra, &rb);
+        img_b[i] = (float)(img_b[i] * (1.0 - s->kappa * ra) / (1.0 - s->kappa * rb));
+    }
+}
+
+/* The weighted sums that put kappa beside the motion in the normal equations, per parity of
+ * the point's index (the split-half check's halves): c = d r / d kappa, the steepest-descent
+ * images sd (the motion's Jacobian over the level's gradient scale), b (B's shaded sample), r. */
+typedef struct shading_sums {
+    double w, wb, wbb, wr, wbr, wc, wbc, wcc, wcr;
+    double wsd[8], wbsd[8], wcsd[8];
+} shading_sums;
+
+static void shading_accumulate(const home__refine_solver *s, int level, const float *aff,
+                               shading_sums *half)
+{
+    const home__refine_points *tp = &s->tpl[level];
+    int i, p;
+    memset(half, 0, 2 * sizeof *half);
+    for (i = 0; i < tp->n; i++) {
+        const double w = s->wt[i];
+        shading_sums *q = &half[i & 1];
+        double u, v, gx, gy, g, ra, rb, b, c, r, sd[8];
+        if (!(w > 0.0)) continue;
+        /* as the accumulate kernel forms them */
+        u = (double)(aff[0] * (float)tp->x[i] + aff[1]);
+        v = (double)(aff[0] * (float)tp->y[i] + aff[2]);
+        gx = tp->gx[i];
+        gy = tp->gy[i];
+        g = gx * u + gy * v;
+        sd[0] = gx * u; sd[1] = gx * v; sd[2] = gx;
+        sd[3] = gy * u; sd[4] = gy * v; sd[5] = gy;
+        sd[6] = -(u * g); sd[7] = -(v * g);
+        shading_radii(s, s->hn, u, v, &ra, &rb);
+        b = s->img_b[i];
+        r = s->res[i];
+        c = s->alpha * b * (rb - ra) / ((1.0 - s->kappa * ra) * (1.0 - s->kappa * rb));
+        q->w += w; q->wb += w * b; q->wbb += w * b * b; q->wr += w * r; q->wbr += w * b * r;
+        q->wc += w * c; q->wbc += w * b * c; q->wcc += w * c * c; q->wcr += w * c * r;
+        for (p = 0; p < 8; p++) {
+            q->wsd[p] += w * sd[p];
+            q->wbsd[p] += w * b * sd[p];
+            q->wcsd[p] += w * c * sd[p];
+        }
+    }
+}
+
+/* kappa's row of the normal equations beside the motion's (gradient scale k), the gain and
+ * bias (fitted beside) taken out of its column first: col (the cross terms with the motion),
+ * kk and gk. 0 when the data hold no falloff's change (no motion, or nothing to shade). */
+static int shading_row(const shading_sums *half, unsigned parities, double k, double *col,
+                       double *kk, double *gk)
+{
+    shading_sums t;
+    double det, g0, g1, cc, cr;
+    int p, q;
+    memset(&t, 0, sizeof t);
+    for (q = 0; q < 2; q++) {
+        const shading_sums *h = &half[q];
+        if (!(parities >> q & 1)) continue;
+        t.w += h->w; t.wb += h->wb; t.wbb += h->wbb; t.wr += h->wr; t.wbr += h->wbr;
+        t.wc += h->wc; t.wbc += h->wbc; t.wcc += h->wcc; t.wcr += h->wcr;
+        for (p = 0; p < 8; p++) {
+            t.wsd[p] += h->wsd[p];
+            t.wbsd[p] += h->wbsd[p];
+            t.wcsd[p] += h->wcsd[p];
+        }
+    }
+    /* c's part beyond the gain and bias: c - g0 - g1 b, weighted least squares */
+    det = t.w * t.wbb - t.wb * t.wb;
+    if (!(det > 1e-9 * t.w * t.w)) return 0;
+    g1 = (t.w * t.wbc - t.wb * t.wc) / det;
+    g0 = (t.wc - g1 * t.wb) / t.w;
+    cc = t.wcc - g0 * t.wc - g1 * t.wbc;
+    cr = t.wcr - g0 * t.wr - g1 * t.wbr;
+    if (!(cc > 1e-12 * t.wcc) || !(cc > 0.0)) return 0;
+    /* the column of -c (the residual r + c dkappa against J dp) */
+    for (p = 0; p < 8; p++) col[p] = -k * (t.wcsd[p] - g0 * t.wsd[p] - g1 * t.wbsd[p]);
+    *kk = cc;
+    *gk = -cr;
+    return 1;
+}
+
+/* kappa taken out of the motion's normal equations (a, g) by the Schur complement. */
+static void eliminate_shading(const double *col, double kk, double gk, double *a, double *g)
+{
+    int p, q;
+    for (p = 0; p < 8; p++) {
+        for (q = 0; q < 8; q++) a[p * 8 + q] -= col[p] * col[q] / kk;
+        g[p] -= col[p] * gk / kk;
+    }
+}
+
 /* One IRLS Gauss-Newton step at a level. Returns 0 when too few points stay usable or the
  * system is singular; *step_px gets the corner motion of the update. */
 static int iterate(home__refine_solver *s, int level, double *step_px)
@@ -237,12 +358,17 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
     const double k = s->f / (2.0 * sc);  /* template gradient: 2x central difference per level px */
     float m[9], aff[3], *acc = s->acc;
-    double a[64], g[8], dp[9], hd[9], hdi[9], t[9];
-    int i, p, valid;
+    double a[64], g[8], dp[9], hd[9], hdi[9], t[9], col[8], kk = 0.0, gk = 0.0;
+    shading_sums half[2];
+    int i, p, valid, shaded = 0;
 
+    aff[0] = (float)(sc / s->f);
+    aff[1] = (float)((o - s->cx) / s->f);
+    aff[2] = (float)((o - s->cy) / s->f);
     home__refine_level_matrix(s, s->hn, level, m);
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
                       st->h[level], s->img_b);
+    if (s->shading) shade_samples(s, level, s->hn, s->img_b);
     s->sigma = home__refine_robust_sigma(s->img_b, tp->t, tp->n, s->alpha, s->beta,
                                          (int32_t *)(void *)s->wt);
     if (s->excluded && s->mask_level != level) {
@@ -254,9 +380,6 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     valid = home__refine_fit_photometric(s, tp, s->img_b, s->excluded ? s->img_b2 : NULL,
                                          s->sigma, s->res, s->wt);
     if (valid < MIN_POINTS) return 0;
-    aff[0] = (float)(sc / s->f);
-    aff[1] = (float)((o - s->cx) / s->f);
-    aff[2] = (float)((o - s->cy) / s->f);
     /* J^T W J at a level's first iteration, then reused while the steps keep halving (a fresh
      * one otherwise, see refine()): in the inverse-compositional form it changes only through
      * the weights, and an approximate matrix changes the path to the solution, not the solution
@@ -265,6 +388,11 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
                        s->hessian_level != level, acc);
     s->hessian_level = level;
     normal_equations(acc, 0xf, k, a, g);
+    if (s->shading) {
+        shading_accumulate(s, level, aff, half);
+        shaded = shading_row(half, 3, k, col, &kk, &gk);
+        if (shaded) eliminate_shading(col, kk, gk, a, g);
+    }
     memcpy(s->jtj, a, sizeof a);
     if (level == s->finest) {
         /* split-half check: the steps of the even and the odd lanes (interleaved halves of the
@@ -273,6 +401,13 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
         double ae[64], ge[8], ao[64], go[8];
         normal_equations(acc, 0x5, k, ae, ge);
         normal_equations(acc, 0xa, k, ao, go);
+        double half_col[8], half_k, half_g;
+        if (shaded) {
+            if (shading_row(half, 1, k, half_col, &half_k, &half_g))
+                eliminate_shading(half_col, half_k, half_g, ae, ge);
+            if (shading_row(half, 2, k, half_col, &half_k, &half_g))
+                eliminate_shading(half_col, half_k, half_g, ao, go);
+        }
         if (model_solve(s, ae, ge) && model_solve(s, ao, go)) {
             for (p = 0; p < 8; p++) ge[p] -= go[p];
             s->split_px = 0.5 * corner_step_px(s, ge);
@@ -283,6 +418,12 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     if (!model_solve(s, a, g)) return 0;
     for (p = 0; p < 8; p++) dp[p] = g[p];
     *step_px = corner_step_px(s, dp);
+    if (shaded) {
+        double dk = gk;
+        for (p = 0; p < 8; p++) dk -= col[p] * dp[p];
+        s->kappa += dk / kk;
+        s->kappa = s->kappa < KAPPA_MIN ? KAPPA_MIN : s->kappa > KAPPA_MAX ? KAPPA_MAX : s->kappa;
+    }
     hd[0] = 1 + dp[0]; hd[1] = dp[1]; hd[2] = dp[2];
     hd[3] = dp[3]; hd[4] = 1 + dp[4]; hd[5] = dp[5];
     hd[6] = dp[6]; hd[7] = dp[7]; hd[8] = 1;
@@ -567,6 +708,7 @@ void home__refine_solver_setup(home_context *ctx, int slot, home__refine_solver 
     s->hessian_level = -1;
     s->mask_level = -1;
     s->signal_share = 1.0;
+    s->rho_scale = s->f * s->f / (s->cx * s->cx + s->cy * s->cy);
     s->k = 8;
     for (s->finest = st->finest_level; s->finest < st->levels - 1; s->finest++) {
         const int cap_half = s->tpl[s->finest].capacity / 2;
@@ -592,6 +734,10 @@ static void compare_estimates(home__refine_solver *s, const double *hn, const do
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s->img_b2);
     home__refine_level_matrix(s, hn0, fl, m);
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[fl], st->w[fl], st->w[fl], st->h[fl], s->img_b);
+    if (s->shading) { /* both under the falloff fitted */
+        shade_samples(s, fl, hn, s->img_b2);
+        shade_samples(s, fl, hn0, s->img_b);
+    }
     if (excluded) {
         int i;
         for (i = 0; i < tp->n; i++)
@@ -670,11 +816,12 @@ static int run_level(home__refine_solver *s, int level, int max_iterations, int 
 }
 
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
- * without the points of the excluded regions (NULL: none), on a probe's leash (NULL: none).
- * Writes the refined H and fills the refine fields of result. */
+ * without the points of the excluded regions (NULL: none), on a probe's leash (NULL: none),
+ * with a lens falloff fitted beside the motion when shading is set. Writes the refined H and
+ * fills the refine fields of result. */
 static double refine_run(home_context *ctx, int slot, const double *h0,
                          const unsigned char *excluded, const probe_leash *leash, int patient,
-                         home_result *result)
+                         int shading, home_result *result)
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
@@ -685,6 +832,7 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
 
     home__refine_solver_setup(ctx, slot, &s);
     s.excluded = excluded;
+    s.shading = shading;
     /* below a homography the update stays in the model (it is a group: I + D(dp) in it keeps
      * the estimate in it), so a few edges that leave a homography undetermined still fix it */
     s.k = 8;
@@ -888,13 +1036,18 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
 double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
                         home_result *result)
 {
-    return refine_run(ctx, slot, h0, NULL, NULL, patient, result);
+    return refine_run(ctx, slot, h0, NULL, NULL, patient, 0, result);
+}
+
+void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, home_result *result)
+{
+    refine_run(ctx, slot, h0, NULL, NULL, 1, 1, result);
 }
 
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,
                                 const unsigned char *excluded, home_result *result)
 {
-    return refine_run(ctx, slot, h0, excluded, NULL, 0, result);
+    return refine_run(ctx, slot, h0, excluded, NULL, 0, 0, result);
 }
 
 void home__refine_probe(home_context *ctx, int slot, const double *h0, const double *back,
@@ -903,5 +1056,5 @@ void home__refine_probe(home_context *ctx, int slot, const double *h0, const dou
     probe_leash leash;
     leash.back = back;
     leash.radius = radius;
-    refine_run(ctx, slot, h0, NULL, &leash, 0, result);
+    refine_run(ctx, slot, h0, NULL, &leash, 0, 0, result);
 }

@@ -767,9 +767,9 @@ static void shade_and_noise(uint8_t *im, double falloff, uint64_t seed)
  *   background's score test (refine_background.c) took it for a background that does not move
  *   and refused 9 of these 10 motions (the stabiliser held those frames). A refused motion of at
  *   most a similarity is now tested again with the falloff's change projected out, and the sky's
- *   faint texture shows it: 10 answered, within 2 px. Not within 3 predicted errors: the template
- *   points' refinement has no shading term and stops 0.2-1.1 px short (docs/trust.md, session
- *   25), which this test records but does not hide;
+ *   faint texture shows it: 10 answered. Without a shading term in the template points'
+ *   refinement they came out 0.03-0.38 px off, 2 of 10 beyond 3 predicted errors (4.8); the
+ *   falloff is now fitted with the motion, and each is within 3;
  * - a still camera, a textured object (a third of the frame) moving 3 px over a plain, faintly
  *   graded background: with the falloff projected out, that background shows nothing either
  *   way. A rule that took "not refuted" for enough let the object's motion through (10 of 10
@@ -806,10 +806,14 @@ void test_lens_shading_pans_and_tripods(void)
                 synth_invert(i ? h : identity, inv);
                 for (y = 0; y < IMG_H; y++)
                     for (x = 0; x < IMG_W; x++) {
-                        double sx, sy, v;
+                        double sx, sy, v, sky;
                         synth_apply(inv, x, y, &sx, &sy);
-                        v = sy < 0.6 * IMG_H ? 185.0 - 20.0 * sy / IMG_H + 0.02 * (im[y * IMG_W + x] - 128.0)
-                                                  : 160.0 + 0.2 * (im[y * IMG_W + x] - 128.0);
+                        /* the horizon's row shares by cover (a hard step would put it on whole
+                         * rows and move it by 0 or 1 px whatever the motion) */
+                        sky = 0.6 * IMG_H - sy + 0.5;
+                        sky = sky < 0.0 ? 0.0 : sky > 1.0 ? 1.0 : sky;
+                        v = sky * (185.0 - 20.0 * sy / IMG_H + 0.02 * (im[y * IMG_W + x] - 128.0)) +
+                            (1.0 - sky) * (160.0 + 0.2 * (im[y * IMG_W + x] - 128.0));
                         im[y * IMG_W + x] = (uint8_t)floor(v + 0.5);
                     }
             }
@@ -841,8 +845,12 @@ void test_lens_shading_pans_and_tripods(void)
                home_refine_status_name(res.refine_status), home_model_name(res.model), err,
                res.sigma_px);
         if (!res.ok) continue;
-        if (tripod) wrong += err > 0.5;
-        else pans++;
+        if (tripod) {
+            wrong += err > 0.5;
+        } else {
+            pans++;
+            CHECK_LT(err, 3.0 * res.sigma_px);
+        }
         CHECK_LT(err, 2.0);
     }
     printf("     pans: %d of 10 answered; tripod: %d answered wrong\n", pans, wrong);
