@@ -15,9 +15,9 @@
  * per-pixel terms: how much of the frame it rests on (a few edge pixels next to the mask
  * decide nothing). Gain and bias (exposure) are projected out; residuals far from the median
  * (occlusion) and clipped pixels are left out. Lens shading stays with the sensor, so r never
- * holds it while p and the predictions hold its change under h: where the caller allows it and
- * p shows a falloff towards the corners, that change is projected out too (else a camera moving
- * over a plain wall through a vignetting lens looks still). */
+ * holds it while p and the predictions hold its change under h: where p shows a falloff towards
+ * the corners, a second set of statistics has that change projected out too (else a camera
+ * moving over a plain wall through a vignetting lens looks still). */
 #include "refine_internal.h"
 #include <math.h>
 #include <string.h>
@@ -462,7 +462,7 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
     double m[9], m_inv[9], median, mad, lo, hi;
     score_sums k;
     memset(stats, 0, 4 * sizeof *stats);
-    if (shaded) memset(shaded, 0, 4 * sizeof *shaded);
+    memset(shaded, 0, 4 * sizeof *shaded);
     if (!prepare(st, a, b, h, m, m_inv, &median, &mad)) return 0;
     lo = median - REJECT_SIGMAS * mad;
     hi = median + REJECT_SIGMAS * mad;
@@ -474,14 +474,14 @@ int home__refine_background_score(home_context *ctx, const uint16_t *a, const ui
      * the same sums serve both tests */
     accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, BORDER, SCREEN_STEP, &k);
     if (k.n * MIN_SHARE * SCREEN_STEP >= (double)w * hh) {
-        if (shaded) shaded_screened = finish_as(&k, 1, shaded) && screen_moves(shaded);
+        shaded_screened = finish_as(&k, 1, shaded) && screen_moves(shaded);
         if (finish_as(&k, 0, stats) && screen_moves(stats)) return 1;
     }
     for (first = BORDER + 1; first < BORDER + SCREEN_STEP; first++)
         accumulate(st, a, b, sa, sb, m, m_inv, lo, hi, first, SCREEN_STEP, &k);
     memset(stats, 0, 4 * sizeof *stats);
-    if (shaded && !shaded_screened) memset(shaded, 0, 4 * sizeof *shaded);
+    if (!shaded_screened) memset(shaded, 0, 4 * sizeof *shaded);
     if (k.n * MIN_SHARE < (double)w * hh) return 0;
-    if (shaded && !shaded_screened) finish_as(&k, 1, shaded);
+    if (!shaded_screened) finish_as(&k, 1, shaded);
     return finish_as(&k, 0, stats);
 }

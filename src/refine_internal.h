@@ -176,9 +176,9 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
  * displacement there (about 0 if it stands still, below 1 if a part of it moves with h, large
  * if it moves otherwise). Every fourth row is tested first: where the background there
  * already shows the motion (observed at least two thirds of expected, both expected and
- * evidence at least 5), those rows' statistics are returned. shaded (NULL: not wanted): the
- * same from the same sums with a lens falloff's change under h projected out (see the file),
- * screened alike. Returns 0 (stats all 0) when there is too little background or no
+ * evidence at least 5), those rows' statistics are returned. shaded[4]: the same from the
+ * same sums with a lens falloff's change under h projected out (see the file), screened
+ * alike. Returns 0 (stats all 0) when there is too little background or no
  * refinement. Uses the match-time scratch. */
 int home__refine_background_score(home_context *ctx, const uint16_t *a, const uint16_t *b,
                                   const double *h, double *stats, double *shaded);

@@ -227,6 +227,16 @@ static int is_excluded(const home__refine_solver *s, const home__refine_points *
     return s->excluded[region_of(tp->x[i], tp->y[i], s->st->w[level], s->st->h[level])] != 0;
 }
 
+/* Template level-`level` pixels to normalised units, as the accumulate kernel takes them:
+ * u = aff[0] x + aff[1], v = aff[0] y + aff[2]. */
+static void level_affine(const home__refine_solver *s, int level, float *aff)
+{
+    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    aff[0] = (float)(sc / s->f);
+    aff[1] = (float)((o - s->cx) / s->f);
+    aff[2] = (float)((o - s->cy) / s->f);
+}
+
 /* Lens shading fixed to the sensor, s(x) = 1 - kappa rho^2(x): frame B's sample at h(x) is
  * s(h(x)) times the scene, A's at x s(x) times it, so B's samples times s(x) / s(h(x)) compare
  * with A. rho^2 of a template point (u, v) and of its image under hn, normalised units. */
@@ -246,11 +256,10 @@ static void shading_radii(const home__refine_solver *s, const double *h, double 
 static void shade_samples(const home__refine_solver *s, int level, const double *hn, float *img_b)
 {
     const home__refine_points *tp = &s->tpl[level];
-    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
-    const float aff[3] = {(float)(sc / s->f), (float)((o - s->cx) / s->f),
-                          (float)((o - s->cy) / s->f)};
+    float aff[3];
     int i;
     if (s->kappa == 0.0) return;
+    level_affine(s, level, aff);
     for (i = 0; i < tp->n; i++) {
         double ra, rb;
         if (img_b[i] < 0.0f) continue;
@@ -355,16 +364,14 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     const home__refine_state *st = s->st;
     const home__refine_points *tp = &s->tpl[level];
     const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
-    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const double sc = (double)(1 << level);
     const double k = s->f / (2.0 * sc);  /* template gradient: 2x central difference per level px */
     float m[9], aff[3], *acc = s->acc;
     double a[64], g[8], dp[9], hd[9], hdi[9], t[9], col[8], kk = 0.0, gk = 0.0;
     shading_sums half[2];
     int i, p, valid, shaded = 0;
 
-    aff[0] = (float)(sc / s->f);
-    aff[1] = (float)((o - s->cx) / s->f);
-    aff[2] = (float)((o - s->cy) / s->f);
+    level_affine(s, level, aff);
     home__refine_level_matrix(s, s->hn, level, m);
     st->rk->warp(m, tp->x, tp->y, n4, st->pyr[level], st->w[level], st->w[level],
                       st->h[level], s->img_b);
@@ -960,7 +967,7 @@ static int determined_subspace(home__refine_solver *s, int level)
     const home__refine_state *st = s->st;
     const home__refine_points *tp = &s->tpl[level];
     const int n4 = (tp->n + LANES - 1) & ~(LANES - 1);
-    const double sc = (double)(1 << level), o = 0.5 * (sc - 1.0);
+    const double sc = (double)(1 << level);
     const double k = s->f / (2.0 * sc);
     const double limit = DETERMINED_STD_PX * sc / s->f; /* normalised units */
     double shift[8][8], o8[8], a[64], g[8], noise[64], aq[64], unused[8], v[8][8], var;
@@ -974,9 +981,7 @@ static int determined_subspace(home__refine_solver *s, int level)
                                          (int32_t *)(void *)s->wt);
     if (home__refine_fit_photometric(s, tp, s->img_b, NULL, s->sigma, s->res, s->wt) < MIN_POINTS)
         return 0;
-    aff[0] = (float)(sc / s->f);
-    aff[1] = (float)((o - s->cx) / s->f);
-    aff[2] = (float)((o - s->cy) / s->f);
+    level_affine(s, level, aff);
     st->rk->accumulate(tp->x, tp->y, tp->gx, tp->gy, s->res, s->wt, n4, aff, 1, s->acc);
     s->hessian_level = level;
     normal_equations(s->acc, 0xf, k, a, g);
