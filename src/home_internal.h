@@ -89,6 +89,8 @@ typedef struct home__refine_state {
     int scored;                       /* the last home__refine_apply() ran the score test on
                                          its answer: */
     double score[3];                  /* ... observed, expected, evidence */
+    double unexplained;               /* the share of regions its ok answer leaves unexplained
+                                         (0: not measured: the identity, or within its sigma) */
     uint32_t dense_ids[2];            /* the frames of the last dense alignment (0: none), */
     int dense_model;                  /* ... its cfg.max_model, */
     int dense_found;                  /* ... whether it found a motion, */
@@ -369,6 +371,12 @@ int home__refine_determined_motion(home_context *ctx, uint32_t id_a, uint32_t id
  * can be strong enough (the stabiliser sums them). */
 int home__refine_last_score(const home_context *ctx, double *observed, double *expected,
                             double *evidence);
+/* The share of frame A's regions that the last home__refine_apply()'s ok motion leaves
+ * unexplained where the identity explains them about as well (src/refine_static.c), 0 where it
+ * was not measured. One pair cannot tell a still background (the motion follows movers over
+ * it) from a second motion in front of a moving camera (a hand, parallax); the stabiliser's
+ * path history can. */
+double home__refine_last_unexplained(const home_context *ctx);
 /* The score test's verdict (src/refine.c): the background would show the motion clearly
  * (expected and evidence, both z scores, large enough) and shows far less of it (observed). */
 int home__refine_score_refutes(double observed, double expected, double evidence);

@@ -160,6 +160,11 @@ int home__refine_last_score(const home_context *ctx, double *observed, double *e
     return 1;
 }
 
+double home__refine_last_unexplained(const home_context *ctx)
+{
+    return ctx->refine.unexplained;
+}
+
 int home__refine_score_refutes(double observed, double expected, double evidence)
 {
     return expected >= BACKGROUND_EVIDENCE && evidence >= BACKGROUND_EVIDENCE &&
@@ -333,6 +338,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
     st->scored = 0;
+    st->unexplained = 0.0;
     if (!st->levels) return;
     slot = find_slot(st, id_a);
     if (slot < 0 || st->pyr_id != id_b || !id_b) {

@@ -19,8 +19,45 @@
 #define PLAIN_FLAT 4         /* a plain region's pixel counts where no score |gx| + |gy| (2x
                                 central differences) within 2 px reaches this: the tails of
                                 the edges next to it differ in blur between frames */
+#define UNEXPLAINED_COST 3.0     /* a region the motion leaves unexplained: its cost over this
+                                    many times the median region's, */
+#define UNEXPLAINED_IDENTITY 1.5 /* ... and the identity's at most this many times the motion's */
 #define PLAIN_HIST_BINS 256  /* the identity's residual histogram: 32 grey levels *
                                 8 bins, the rest in one */
+
+static int compare_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Share of the regions with points (at least REGION_POINTS) that the motion leaves unexplained:
+ * its mean cost a point over UNEXPLAINED_COST times the median region's, and the identity's
+ * at most UNEXPLAINED_IDENTITY times the motion's there (the part of the frame that does not
+ * move so: a second motion, or a still background where h follows movers). cost[e][k][r]: the
+ * region's summed cost under e (0: h, 1: the identity) with gain and bias k. */
+static double unexplained_share(double cost[2][2][REGIONS_X * REGIONS_Y],
+                                const int *count)
+{
+    double per_point[REGIONS_X * REGIONS_Y], median;
+    int r, n = 0, left = 0;
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++)
+        if (count[r] >= REGION_POINTS)
+            per_point[n++] = (cost[0][0][r] < cost[0][1][r] ? cost[0][0][r] : cost[0][1][r]) /
+                             count[r];
+    if (n < REGIONS_X * REGIONS_Y / 4) return 0.0;
+    qsort(per_point, (size_t)n, sizeof per_point[0], compare_double);
+    median = n % 2 ? per_point[n / 2] : 0.5 * (per_point[n / 2 - 1] + per_point[n / 2]);
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
+        double cost_h, cost_i;
+        if (count[r] < REGION_POINTS) continue;
+        cost_h = cost[0][0][r] < cost[0][1][r] ? cost[0][0][r] : cost[0][1][r];
+        cost_i = cost[1][0][r] < cost[1][1][r] ? cost[1][0][r] : cost[1][1][r];
+        left += cost_h > UNEXPLAINED_COST * median * count[r] &&
+                cost_i <= UNEXPLAINED_IDENTITY * cost_h;
+    }
+    return (double)left / n;
+}
 
 /* Share of the frame's regions (a REGIONS_X x REGIONS_Y grid; those with at least REGION_POINTS
  * of the region points vote) whose points the identity explains better than h (pixels) does:
@@ -33,7 +70,7 @@
 double home__refine_identity_share(home_context *ctx, int slot, const double *h,
                                     double *clear_share, int *against, unsigned char *still)
 {
-    const home__refine_state *st = &ctx->refine;
+    home__refine_state *st = &ctx->refine;
     double cost[2][2][REGIONS_X * REGIONS_Y], gain[2], bias[2], hn[9], sigma, c, cost_h, cost_i;
     int count[REGIONS_X * REGIONS_Y], e, i, k, r, votes = 0;
     int wins = 0, clear_votes = 0, clear_wins = 0, fl, n4;
@@ -44,6 +81,7 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
     region_grid grid;
     *clear_share = 0.0;
     *against = 0;
+    st->unexplained = 0.0;
     if (still) memset(still, 0, REGIONS_X * REGIONS_Y);
     home__refine_solver_setup(ctx, slot, &s);
     fl = st->region_level;
@@ -85,6 +123,7 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
                 cost[e][k][r] += robust_cost(gain[k] * v + bias[k] - tp->t[i], c);
         }
     }
+    st->unexplained = unexplained_share(cost, count);
     for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
         const double apart = faint[r] ? DECISIVE_GREY_FAINT : DECISIVE_GREY;
         const double ratio = faint[r] ? DECISIVE_RATIO_FAINT : DECISIVE_RATIO;

@@ -45,6 +45,8 @@ typedef struct stab_slot {
     int has_score;                /* its motion, registered ok, had the still-background score
                                      test: */
     double score[3];              /* ... observed, expected, evidence (home__refine_last_score) */
+    double unexplained;           /* ... and the share of regions it left unexplained
+                                     (home__refine_last_unexplained) */
     int smoothed_ready;           /* its segment has ended: `smoothed` is its final path */
     home_stab_sim smoothed;
 } stab_slot;

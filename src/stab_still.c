@@ -12,7 +12,9 @@
  * A still background refutes what one frame cannot: where the background is plain (fog), one
  * pair's score test is too weak to refuse the objects' motion HOME registers, but the tests of
  * the frames around, summed, can be strong enough; a motion they refute, and its own test leans
- * against, becomes none. */
+ * against, becomes none. Where the background shows nothing to test, a motion that leaves a
+ * part of the frame unexplained which the identity explains becomes none when the camera was
+ * not moving before it (its last decided frames). */
 #include "stab_internal.h"
 #include "home_internal.h"
 #include <math.h>
@@ -27,6 +29,8 @@
 #define STILL_KNOCK 0.02
 #define BACKGROUND_BEFORE 30   /* the score tests summed: frames before the motion (as far as
                                   the ring holds them; and up to STILL_AFTER after it) */
+#define UNEXPLAINED_SHARE 0.08 /* a motion leaving this share of the regions unexplained, */
+#define UNEXPLAINED_DECIDED 4  /* ... judged by this many decided frames before it */
 #define RESTORE_BEFORE 8       /* frames looked at before a refused motion (and up to STILL_AFTER
                                   after it), */
 #define RESTORE_MIN 2          /* registered moving (ok, not the identity), with none still */
@@ -136,13 +140,40 @@ static int background_refutes(const home_stab *st, long t, long newest)
                                                expected / sqrt(spread));
 }
 
+/* Does t's motion leave much of the frame unexplained where the identity explains it, on a
+ * camera that was not moving? Per pair the share cannot tell a still background under
+ * moving objects from a hand or parallax in front of a moving camera; the path can: the last
+ * frames before t whose motion was decided (held ones tell nothing) show whether the camera
+ * was moving: where more than half of them moved, it keeps its motions. */
+static int leaves_still_part(const home_stab *st, long t)
+{
+    const stab_slot *s = slot_of(st, t);
+    long i;
+    int moved = 0, decided = 0;
+    if (s->status != HOME_STAB_MOTION_OK || s->registered_still ||
+        s->unexplained < UNEXPLAINED_SHARE)
+        return 0;
+    for (i = t - 1; i > st->first && i >= t - BACKGROUND_BEFORE && decided < UNEXPLAINED_DECIDED;
+         i--) {
+        const stab_slot *n = slot_of(st, i);
+        const int moving = (n->status == HOME_STAB_MOTION_OK && !n->registered_still) ||
+                           n->status == HOME_STAB_MOTION_RESTORED ||
+                           n->status == HOME_STAB_MOTION_BRIDGED;
+        if (n->frame != i) break;
+        moved += moving;
+        decided += moving || n->registered_still || n->status == HOME_STAB_MOTION_STILL;
+    }
+    return 2 * moved <= decided;
+}
+
 /* Decide frame t's motion once the frames up to newest are in: a lone one, or one the
  * background around refutes, becomes none. */
 void home__stab_settle_still(home_stab *st, long t, long newest)
 {
     static const home_stab_sim none = {0, 0, 0, 0};
     if (t <= st->first || t < st->emitted ||
-        !(is_lone(st, t, newest) || background_refutes(st, t, newest)))
+        !(is_lone(st, t, newest) || background_refutes(st, t, newest) ||
+          leaves_still_part(st, t)))
         return;
     home__stab_retake_motion(st, t, newest, &none, HOME_STAB_MOTION_STILL, slot_of(st, t)->weight);
 }

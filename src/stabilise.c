@@ -469,6 +469,8 @@ static int bridge(home_stab *st, long n)
             return 0;
         all_held &= held_for_good(s);
     }
+    /* frames settled since the anchor was set may have shown a still camera after all */
+    if (!home__stab_camera_moves(st, a)) return 0;
     for (k = n; k > a && !held_for_good(slot_of(st, k)); k--)
         ;
     if (k <= a || (all_held ? a + 1 : k) < st->emitted) return 0;
@@ -503,6 +505,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     home_features *swap;
     home_stab_sim motion = {0, 0, 0, 0}, candidate = {0, 0, 0, 0};
     double weight = 1.0, candidate_weight = 1.0, score[3] = {0.0, 0.0, 0.0};
+    double unexplained = 0.0;
     int has_candidate = 0, has_score = 0;
     stab_slot *slot;
     double t0 = 0, z[4];
@@ -528,6 +531,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
             if (plausible_motion(st, &out->reg, &motion, &weight))
                 out->newest_status = HOME_STAB_MOTION_OK;
             has_score = home__refine_last_score(st->home, &score[0], &score[1], &score[2]);
+            unexplained = home__refine_last_unexplained(st->home);
         } else if (out->reg.refine_status == HOME_REFINE_STILL_BACKGROUND) {
             has_candidate = plausible_motion(st, &out->reg, &candidate, &candidate_weight);
         } else if (partial_motion(st, &out->reg, &motion, &weight)) {
@@ -550,6 +554,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
         memset(&motion, 0, sizeof motion);
         has_candidate = 0;
         has_score = 0;
+        unexplained = 0.0;
     }
     st->cut_requested = 0;
     if (st->cfg.clock) out->ms_register = st->cfg.clock(st->cfg.clock_user) - t0;
@@ -566,6 +571,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     slot->candidate_weight = candidate_weight;
     slot->has_score = has_score;
     memcpy(slot->score, score, sizeof score);
+    slot->unexplained = unexplained;
     slot->smoothed_ready = 0;
     if (n == st->first) {
         memset(&slot->raw, 0, sizeof slot->raw);

@@ -729,8 +729,10 @@ static void test_static_camera_moving_object(void)
 
 /* A tripod shot of fog with textured objects crossing it, a live camera's frames (new noise in
  * every frame): one pair's background is too plain to refute the objects' motion, which HOME
- * then reports ok; the score tests of the frames around, summed, refute most of them, and those
- * are taken as none. Not all: the path still wanders (less than a third as far). */
+ * then reports ok; the score tests of the frames around, summed, refute most of them, and a
+ * motion that leaves a still part of the frame unexplained on a camera that was not moving is
+ * taken as none too. Not all: two motions leave too little unexplained (a share of 0.07), and
+ * the path still wanders that far. */
 static void test_static_fog_with_objects(void)
 {
     static uint8_t frame[CW * CH * 3 / 2];
@@ -772,9 +774,10 @@ static void test_static_fog_with_objects(void)
     }
     printf("    %d frames out: %d with a motion, %d held as still; largest raw path excursion "
            "%.2f px\n", n, ok, still, worst);
-    /* without the summed tests: 37 motions, none held, 137 px */
+    /* without the summed tests: 37 motions, none held, 137 px; without the unexplained part
+     * (dd50476): 27 held, 24.3 px */
     CHECK(2 * still >= n);
-    CHECK_LT(worst, 40.0);
+    CHECK_LT(worst, 12.0);
 }
 
 /* ---- the crop after the fact (home-stab's adaptive crop) ---- */
