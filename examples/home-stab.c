@@ -45,6 +45,8 @@ static void usage(FILE *f)
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"
             "  --refine-finest L end the refinement at full (0) or half (1) size (default 1)\n"
+            "  --no-key-frames   do not register frames that leave a part unexplained (an object\n"
+            "                    crossing, a hand) against the frame before it came (less memory)\n"
             "  --hough-downscale N  HOME's Hough transform on the registration image (1) or on\n"
             "                    its 1/2 or 1/4 size copy (2, 4; default: 4 down to 96 px wide,\n"
             "                    else 2 from 320 px)\n"
@@ -309,7 +311,7 @@ int main(int argc, char **argv)
     void *arena = NULL;
     FILE *in;
     char err[256];
-    int i, status, rc = 0, got, refine = 1, adaptive = 1;
+    int i, status, rc = 0, got, refine = 1, adaptive = 1, key_frames = 1;
     plan planned_path = {NULL, 0, 0};
     long data_start = 0;
     long frames = 0, failed = 0, cuts = 0;
@@ -323,6 +325,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--side-by-side")) { ap.side_by_side = 1; continue; }
         if (!strcmp(a, "--quiet")) { ap.quiet = 1; continue; }
         if (!strcmp(a, "--no-refine")) { refine = 0; continue; }
+        if (!strcmp(a, "--no-key-frames")) { key_frames = 0; continue; }
         if (!strcmp(a, "--fixed-crop")) { adaptive = 0; continue; }
         if (!strcmp(a, "-") || a[0] != '-') {
             if (!in_path) in_path = a;
@@ -371,6 +374,7 @@ int main(int argc, char **argv)
     cfg.keypoints_per_sign = (int)keypoints;
     cfg.refine = refine;
     if (refine_finest >= 0) cfg.refine_finest_level = (int)refine_finest;
+    cfg.key_frames = key_frames;
     if (hough_ds > 0) cfg.hough_downscale = (int)hough_ds;
     cfg.theta_bins = (int)theta_bins;
     cfg.clock = now_ms;

@@ -110,6 +110,14 @@ typedef struct home_stab_config {
     int simd;                 /* enum home_simd for HOME (default AUTO: the HOME_SIMD env or the
                                  best compiled in); the warp takes the best this CPU has (all
                                  backends give the same bytes) */
+    int key_frames;           /* 1 (the default): a frame whose motion leaves a part of the
+                                 frame unexplained while the camera moves (an object crossing,
+                                 a hand at the lens) is also registered against the last frame
+                                 before that part appeared, with HOME's still-pair defaults, and
+                                 the path follows that registration where the two disagree
+                                 (docs/stabiliser.md). Costs a second HOME context and a frame
+                                 in the arena (640x360: 1.8 -> 4.1 MB) and a registration
+                                 (about 7 ms at 640x360, x86) on such frames; 0: off */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
     float max_rotation;       /* plausible per-frame rotation, radians */
     float max_zoom;           /* plausible per-frame |log scale| */
@@ -167,7 +175,7 @@ typedef struct home_stab home_stab;
  * downscale 2 for frames wider than 960 px (else 1), then home_video_config()'s choices for the
  * registration image (500 keypoints per sign; automatic hough_downscale: the 4x4-box copy where
  * that is at least 96 px wide, else home_video_config's) with 88 theta bins, a theta window from
- * max_rotation, refinement on with 1024 points, ending at half size. */
+ * max_rotation, refinement on with 1024 points, ending at half size; key frames on. */
 int home_stab_default_config(home_stab_config *cfg, int width, int height);
 
 /* HOME_OK when every field is in range (sizes even, registration size within HOME's limits). */

@@ -73,6 +73,12 @@ struct home_stab {
     int thumb_index;              /* thumb[thumb_index]: the newest frame's */
     float thumb[2][HOME__STAB_THUMB_CELLS]; /* coarse luma of the last two frames (cuts) */
     double q, r, norm;            /* process / measurement noise, px per radian or log-scale */
+    home_context *key_home;       /* the key frame's registration (NULL: none) */
+    uint8_t *key_luma;            /* the key frame: the last frame whose motion left nothing
+                                     unexplained, away from frames that did (key_frame; -1:
+                                     none), as registered */
+    long key_frame, last_unexplained;
+    long key_agreed;              /* the last frame whose key registration agreed with the path */
 };
 
 static inline stab_slot *slot_of(const home_stab *st, long frame)
@@ -87,6 +93,7 @@ home_stab_sim home__stab_sim_inverse(const home_stab_sim *a);
 home_stab_sim home__stab_sim_scaled(const home_stab_sim *a, double k);
 void home__stab_apply(const double *h, double x, double y, double *u, double *v);
 double home__stab_fit_similarity(const home_stab *st, const double *h, home_stab_sim *out);
+double home__stab_corner_motion(const home_stab *st, const home_stab_sim *m);
 
 /* stab_path.c */
 void home__stab_path_components(const home_stab *st, const home_stab_sim *s, double *z);
@@ -101,6 +108,11 @@ long home__stab_still_delay(const home_stab *st);
 void home__stab_settle_still(home_stab *st, long t, long newest);
 void home__stab_settle_restored(home_stab *st, long t, long newest);
 int home__stab_camera_moves(const home_stab *st, long t);
+/* Frame s's ok motion leaves a part of the frame unexplained (a second motion, or a still
+ * background under moving objects). */
+int home__stab_leaves_part(const stab_slot *s);
+/* How many of the last decided frames before t moved (and how many were decided). */
+int home__stab_moved_before(const home_stab *st, long t, int *decided);
 /* Frame t's motion becomes m (status, weight): the path from t on is composed and filtered
  * again up to newest. */
 void home__stab_retake_motion(home_stab *st, long t, long newest, const home_stab_sim *m,

@@ -93,3 +93,18 @@ double home__stab_fit_similarity(const home_stab *st, const double *h, home_stab
     }
     return sqrt(res / n);
 }
+
+/* RMS displacement of the frame's corners under the similarity m, px. */
+double home__stab_corner_motion(const home_stab *st, const home_stab_sim *m)
+{
+    const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
+    const double k = exp(m->log_scale), a = k * cos(m->angle) - 1.0, b = k * sin(m->angle);
+    double sum = 0.0;
+    int i;
+    for (i = 0; i < 4; i++) {
+        const double x = (i & 1) ? cx : -cx, y = (i & 2) ? cy : -cy;
+        const double u = a * x - b * y + m->tx, v = b * x + a * y + m->ty;
+        sum += u * u + v * v;
+    }
+    return sqrt(sum / 4.0);
+}

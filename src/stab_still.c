@@ -40,21 +40,6 @@ long home__stab_still_delay(const home_stab *st)
     return st->cfg.lookahead < STILL_AFTER ? st->cfg.lookahead : STILL_AFTER;
 }
 
-/* RMS displacement of the frame's corners under the similarity m, px. */
-static double corner_motion(const home_stab *st, const home_stab_sim *m)
-{
-    const double cx = 0.5 * (st->cfg.width - 1), cy = 0.5 * (st->cfg.height - 1);
-    const double k = exp(m->log_scale), a = k * cos(m->angle) - 1.0, b = k * sin(m->angle);
-    double sum = 0.0;
-    int i;
-    for (i = 0; i < 4; i++) {
-        const double x = (i & 1) ? cx : -cx, y = (i & 2) ? cy : -cy;
-        const double u = a * x - b * y + m->tx, v = b * x + a * y + m->ty;
-        sum += u * u + v * v;
-    }
-    return sqrt(sum / 4.0);
-}
-
 static int is_lone(const home_stab *st, long t, long newest)
 {
     const stab_slot *s = slot_of(st, t);
@@ -62,7 +47,7 @@ static int is_lone(const home_stab *st, long t, long newest)
     long i;
     int still = 0, moved = 0;
     if (s->status != HOME_STAB_MOTION_OK || s->registered_still ||
-        corner_motion(st, &s->motion) > STILL_KNOCK * st->norm)
+        home__stab_corner_motion(st, &s->motion) > STILL_KNOCK * st->norm)
         return 0;
     for (i = t - (STILL_NEIGHBOURS - after); i <= t + after; i++)
         if (i != t && i > st->first && slot_of(st, i)->frame == i) {
@@ -140,20 +125,21 @@ static int background_refutes(const home_stab *st, long t, long newest)
                                                expected / sqrt(spread));
 }
 
-/* Does t's motion leave much of the frame unexplained where the identity explains it, on a
- * camera that was not moving? Per pair the share cannot tell a still background under
- * moving objects from a hand or parallax in front of a moving camera; the path can: the last
- * frames before t whose motion was decided (held ones tell nothing) show whether the camera
- * was moving: where more than half of them moved, it keeps its motions. */
-static int leaves_still_part(const home_stab *st, long t)
+int home__stab_leaves_part(const stab_slot *s)
 {
-    const stab_slot *s = slot_of(st, t);
+    return s->status == HOME_STAB_MOTION_OK && !s->registered_still &&
+           s->unexplained >= UNEXPLAINED_SHARE;
+}
+
+/* The last UNEXPLAINED_DECIDED frames before t whose motion was decided (held ones tell
+ * nothing; up to BACKGROUND_BEFORE back): how many there are, and how many of them moved
+ * (registered moving, restored or bridged, against registered the identity or still). */
+int home__stab_moved_before(const home_stab *st, long t, int *decided)
+{
     long i;
-    int moved = 0, decided = 0;
-    if (s->status != HOME_STAB_MOTION_OK || s->registered_still ||
-        s->unexplained < UNEXPLAINED_SHARE)
-        return 0;
-    for (i = t - 1; i > st->first && i >= t - BACKGROUND_BEFORE && decided < UNEXPLAINED_DECIDED;
+    int moved = 0;
+    *decided = 0;
+    for (i = t - 1; i > st->first && i >= t - BACKGROUND_BEFORE && *decided < UNEXPLAINED_DECIDED;
          i--) {
         const stab_slot *n = slot_of(st, i);
         const int moving = (n->status == HOME_STAB_MOTION_OK && !n->registered_still) ||
@@ -161,9 +147,20 @@ static int leaves_still_part(const home_stab *st, long t)
                            n->status == HOME_STAB_MOTION_BRIDGED;
         if (n->frame != i) break;
         moved += moving;
-        decided += moving || n->registered_still || n->status == HOME_STAB_MOTION_STILL;
+        *decided += moving || n->registered_still || n->status == HOME_STAB_MOTION_STILL;
     }
-    return 2 * moved <= decided;
+    return moved;
+}
+
+/* Does t's motion leave much of the frame unexplained where the identity explains it, on a
+ * camera that was not moving? Per pair the share cannot tell a still background under moving
+ * objects from a hand or parallax in front of a moving camera; the path can. */
+static int leaves_still_part(const home_stab *st, long t)
+{
+    int decided, moved;
+    if (!home__stab_leaves_part(slot_of(st, t))) return 0;
+    moved = home__stab_moved_before(st, t, &decided);
+    return 2 * moved <= decided; /* more than half moved: a moving camera keeps its motions */
 }
 
 /* Decide frame t's motion once the frames up to newest are in: a lone one, or one the

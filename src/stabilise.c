@@ -23,6 +23,15 @@
  * pulls the path less; beyond STAB_MAX_SIGMA_PX the frame holds the path. */
 #define STAB_SIGMA_REF_PX 0.5
 #define STAB_MAX_SIGMA_PX 4.0
+/* Key frames (key_check(), key_update()): */
+#define STAB_KEY_THETA_BINS 240 /* theta bins of their registration */
+#define STAB_KEY_MAX_AGE 30     /* frames after the key frame that are registered against it */
+#define STAB_KEY_QUIET 8        /* a frame becomes the key frame only this many frames after
+                                   the last one that left a part of the frame unexplained */
+#define STAB_KEY_APART_PX 3.0   /* the key registration overrules the path when the two are
+                                   this far apart (corner px) beyond 3 of its sigma_px, */
+#define STAB_KEY_AGREE_PX 1.0   /* ... and vouches for it within this: the next */
+#define STAB_KEY_TRUSTED 8      /* ... this many frames are not checked */
 /* A scene cut: thumbnails correlating below STAB_CUT_SIMILARITY at every shift of up to
  * max_shift (at most STAB_CUT_MAX_SHIFT_CELLS cells, so that most cells are compared) */
 #define STAB_CUT_SIMILARITY 0.5
@@ -76,6 +85,7 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
         cfg->keypoints_per_sign = h.keypoints_per_sign;
         cfg->simd = h.simd;   /* HOME's default, including its HOME_SIMD override */
     }
+    cfg->key_frames = 1;
     cfg->max_shift = 0.15f;
     cfg->max_rotation = 0.15f;
     cfg->max_zoom = 0.10f;
@@ -131,6 +141,7 @@ int home_stab_validate_config(const home_stab_config *cfg)
         !(cfg->smoothing == 0.0f || is_finite_in(cfg->smoothing, 1.0, 1000.0)) ||
         cfg->lookahead < 0 || cfg->lookahead > HOME_STAB_MAX_LOOKAHEAD ||
         !is_finite_in(cfg->ease, 0.0, 1.0) || (cfg->refine != 0 && cfg->refine != 1) ||
+        (cfg->key_frames != 0 && cfg->key_frames != 1) ||
         (cfg->refine_finest_level != 0 && cfg->refine_finest_level != 1) ||
         !is_finite_in(cfg->max_shift, 0.0, 1.0) || !is_finite_in(cfg->max_rotation, 0.0, 1.6) ||
         !is_finite_in(cfg->max_zoom, 0.0, 1.0) || !is_finite_in(cfg->max_residual, 0.0, 1e6))
@@ -145,12 +156,32 @@ static int ring_length(const home_stab_config *cfg)
 }
 
 typedef struct stab_layout {
-    size_t stab, home, feat, small, ring, total;
-    size_t home_bytes;
+    size_t stab, home, feat, small, ring, key_home, key_luma, total;
+    size_t home_bytes, key_home_bytes;
 } stab_layout;
+
+/* The key frame's registration: HOME's still-pair defaults on the registration image (a
+ * full-size Hough transform: the downscaled one the frames use finds too few lines past a
+ * large occluder), capped at a similarity as the frames are. */
+static int key_config_for(const home_config *h, home_config *key)
+{
+    int status = home_default_config(key, h->width, h->height);
+    if (status != HOME_OK) return status;
+    key->max_model = HOME_MODEL_SIMILARITY;
+    /* half the bins and a quarter of the points: as accurate past an occluder, cheaper */
+    key->wrap_band = key->wrap_band * STAB_KEY_THETA_BINS / key->theta_bins;
+    key->theta_bins = STAB_KEY_THETA_BINS;
+    key->refine_points = STAB_REFINE_POINTS;
+    key->refine_finest_level = 1;
+    key->simd = h->simd;
+    key->clock = h->clock;
+    key->clock_user = h->clock_user;
+    return home_validate_config(key);
+}
 
 static void plan(const home_stab_config *cfg, const home_config *h, stab_layout *l)
 {
+    home_config key;
     size_t at = 0;
     l->stab = at; at = align_up(at + sizeof(home_stab));
     l->home_bytes = home_arena_size(h);
@@ -158,6 +189,12 @@ static void plan(const home_stab_config *cfg, const home_config *h, stab_layout 
     l->feat = at; at = align_up(at + 3 * sizeof(home_features)); /* previous, current, anchor */
     l->small = at; at = align_up(at + (size_t)h->width * (size_t)h->height);
     l->ring = at; at = align_up(at + (size_t)ring_length(cfg) * sizeof(stab_slot));
+    l->key_home_bytes = 0;
+    if (cfg->key_frames && key_config_for(h, &key) == HOME_OK) {
+        l->key_home_bytes = home_arena_size(&key);
+        l->key_home = at; at = align_up(at + l->key_home_bytes);
+        l->key_luma = at; at = align_up(at + (size_t)h->width * (size_t)h->height);
+    }
     l->total = at;
 }
 
@@ -208,6 +245,14 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     st->small_h = h.height;
     st->ring = (stab_slot *)(void *)(base + l.ring);
     st->ring_len = ring_length(cfg);
+    st->key_frame = st->last_unexplained = st->key_agreed = -1;
+    if (l.key_home_bytes) {
+        home_config key;
+        key_config_for(&h, &key);
+        status = home_init(&st->key_home, &key, base + l.key_home, l.key_home_bytes, NULL);
+        if (status != HOME_OK) return status;
+        st->key_luma = base + l.key_luma;
+    }
     /* Kalman bandwidth ~ (q/r)^(1/4) per frame for the constant-velocity model */
     st->r = 1.0;
     st->q = 1.0 / pow(stab_time_constant(cfg), 4.0);
@@ -223,6 +268,7 @@ int home_stab_reset(home_stab *st)
     if (st->magic != STAB_MAGIC) return HOME_E_STATE;
     st->pushed = st->emitted = st->first = 0;
     st->tail = st->cut_requested = 0;
+    st->key_frame = st->last_unexplained = st->key_agreed = -1;
     return HOME_OK;
 }
 
@@ -446,6 +492,34 @@ static int held_for_good(const stab_slot *s)
            s->status == HOME_STAB_MOTION_IMPLAUSIBLE;
 }
 
+/* The path from frame a to frame n becomes m_an (weight): where every frame of (a, n] was held
+ * each takes an equal share, else frame k (the last held one, or n itself) takes what closes
+ * the gap and the motions after it stay. */
+static void close_gap(home_stab *st, long a, long k, long n, int all_held,
+                      const home_stab_sim *m_an, double weight)
+{
+    home_stab_sim target, post, m_k;
+    long i;
+    if (all_held) {
+        const home_stab_sim share = home__stab_sim_scaled(m_an, 1.0 / (double)(n - a));
+        for (i = a + 1; i < n; i++)
+            home__stab_retake_motion(st, i, n, &share, HOME_STAB_MOTION_BRIDGED, weight);
+    }
+    /* raw_n' = m_an raw_a, and raw_n' = post m_k raw_(k-1), post the motions after k */
+    target = home__stab_sim_compose(m_an, &slot_of(st, a)->raw);
+    {
+        const home_stab_sim inv_k = home__stab_sim_inverse(&slot_of(st, k)->raw);
+        post = home__stab_sim_compose(&slot_of(st, n)->raw, &inv_k);
+    }
+    {
+        const home_stab_sim inv_post = home__stab_sim_inverse(&post);
+        const home_stab_sim inv_before = home__stab_sim_inverse(&slot_of(st, k - 1)->raw);
+        const home_stab_sim rest = home__stab_sim_compose(&target, &inv_before);
+        m_k = home__stab_sim_compose(&inv_post, &rest);
+    }
+    home__stab_retake_motion(st, k, n, &m_k, HOME_STAB_MOTION_BRIDGED, weight);
+}
+
 /* Frame n (features in feat[0]) against the anchor, the last frame a before a hold among
  * frames that register a moving camera (home__stab_camera_moves()): when HOME
  * registers it there, the held frames in (a, n] take the motion that makes the path from a to
@@ -456,7 +530,7 @@ static int held_for_good(const stab_slot *s)
 static int bridge(home_stab *st, long n)
 {
     home_result reg;
-    home_stab_sim m_an, target, post, m_k;
+    home_stab_sim m_an;
     double weight;
     long a = st->anchor_frame, k, i;
     int all_held = 1;
@@ -477,25 +551,77 @@ static int bridge(home_stab *st, long n)
     if (home_match(st->home, st->anchor, st->feat[0], &reg) != HOME_OK || !reg.ok ||
         !plausible_motion(st, &reg, &m_an, &weight))
         return 0;
-    if (all_held) {
-        const home_stab_sim share = home__stab_sim_scaled(&m_an, 1.0 / (double)(n - a));
-        for (i = a + 1; i < n; i++)
-            home__stab_retake_motion(st, i, n, &share, HOME_STAB_MOTION_BRIDGED, weight);
-    }
-    /* raw_n' = m_an raw_a, and raw_n' = post m_k raw_(k-1), post the motions after k */
-    target = home__stab_sim_compose(&m_an, &slot_of(st, a)->raw);
-    {
-        const home_stab_sim inv_k = home__stab_sim_inverse(&slot_of(st, k)->raw);
-        post = home__stab_sim_compose(&slot_of(st, n)->raw, &inv_k);
-    }
-    {
-        const home_stab_sim inv_post = home__stab_sim_inverse(&post);
-        const home_stab_sim inv_before = home__stab_sim_inverse(&slot_of(st, k - 1)->raw);
-        const home_stab_sim rest = home__stab_sim_compose(&target, &inv_before);
-        m_k = home__stab_sim_compose(&inv_post, &rest);
-    }
-    home__stab_retake_motion(st, k, n, &m_k, HOME_STAB_MOTION_BRIDGED, weight);
+    close_gap(st, a, k, n, all_held, &m_an, weight);
     return 1;
+}
+
+/* Frame n's ok motion leaves a part of the frame unexplained while the camera moves: a second
+ * motion (an object crossing, a hand at the lens) that HOME may have followed instead of the
+ * camera. The key frame, from before that part appeared, is registered against frame n (HOME's
+ * still-pair defaults); where that places frame n farther from the path than 3 of its
+ * predicted errors and STAB_KEY_APART_PX allow, the path takes it, as a bridge: the object's
+ * motion is not the camera's, and frames held on the way get their missed motion. An answer HOME refuses
+ * only because its refinement did not converge (the moving part pulls it) is used too; one
+ * refused because the background stood still is not (a still camera over movers). */
+static void key_check(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stride)
+{
+    const long a = st->key_frame;
+    home_result reg;
+    home_stab_sim m_an, chain, off;
+    double weight, d;
+    long k, i;
+    int decided;
+    /* the key frame's path must still be in the ring (causal: 11 frames) */
+    if (!st->key_home || a < st->first || a >= n || n - a > STAB_KEY_MAX_AGE ||
+        (st->key_agreed > a && n - st->key_agreed <= STAB_KEY_TRUSTED) ||
+        n - a >= st->ring_len || slot_of(st, a)->frame != a)
+        return;
+    /* a camera that moved in most of the decided frames before (else the frame may be a
+     * still camera's over moving objects: stab_still.c decides those) */
+    if (2 * home__stab_moved_before(st, n, &decided) <= decided) return;
+    /* not across a cut, nor over a frame the restore may still take */
+    for (i = a + 1; i <= n; i++) {
+        const stab_slot *s = slot_of(st, i);
+        if (s->status == HOME_STAB_MOTION_CUT ||
+            (s->status == HOME_STAB_MOTION_FAILED && s->has_candidate &&
+             i > n - home__stab_still_delay(st)))
+            return;
+    }
+    for (k = n; k > a && !held_for_good(slot_of(st, k)); k--)
+        ;
+    if (k <= a || k < st->emitted) k = n;
+    if (home_register(st->key_home, st->key_luma, st->small_w, luma, stride, &reg) != HOME_OK)
+        return;
+    if (!(reg.ok || reg.refine_status == HOME_REFINE_NOT_CONVERGED) ||
+        !plausible_motion(st, &reg, &m_an, &weight))
+        return;
+    {
+        const home_stab_sim inv_a = home__stab_sim_inverse(&slot_of(st, a)->raw);
+        chain = home__stab_sim_compose(&slot_of(st, n)->raw, &inv_a);
+    }
+    {
+        const home_stab_sim inv_chain = home__stab_sim_inverse(&chain);
+        off = home__stab_sim_compose(&m_an, &inv_chain);
+    }
+    d = home__stab_corner_motion(st, &off) - 3.0 * reg.sigma_px * st->cfg.downscale;
+    if (d <= STAB_KEY_AGREE_PX) st->key_agreed = n;
+    if (d > STAB_KEY_APART_PX) close_gap(st, a, k, n, 0, &m_an, weight);
+}
+
+/* Frame n becomes the key frame when its motion left nothing unexplained and none of the
+ * STAB_KEY_QUIET frames before it did (a frame between two that did may be the object's
+ * motion with little left over). */
+static void key_update(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stride)
+{
+    const stab_slot *s = slot_of(st, n);
+    int y;
+    if (!st->key_home) return;
+    if (!(n == st->first || s->status == HOME_STAB_MOTION_OK) ||
+        (n - st->last_unexplained <= STAB_KEY_QUIET && st->last_unexplained >= st->first))
+        return;
+    for (y = 0; y < st->small_h; y++)
+        memcpy(st->key_luma + (ptrdiff_t)y * st->small_w, luma + y * stride, (size_t)st->small_w);
+    st->key_frame = n;
 }
 
 int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output *out)
@@ -596,6 +722,12 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
         st->anchor = st->feat[1];
         st->feat[1] = swap;
         st->anchor_frame = n - 1;
+    }
+    if (home__stab_leaves_part(slot)) {
+        st->last_unexplained = n;
+        key_check(st, n, luma, stride);
+    } else {
+        key_update(st, n, luma, stride);
     }
     home__stab_settle_still(st, n - home__stab_still_delay(st), n);
     home__stab_settle_restored(st, n - home__stab_still_delay(st), n);
