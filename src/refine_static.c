@@ -25,10 +25,15 @@
 #define PLAIN_HIST_BINS 256  /* the identity's residual histogram: 32 grey levels *
                                 8 bins, the rest in one */
 
-static int compare_double(const void *a, const void *b)
+/* Sorts v[0..n) ascending (a few dozen values: insertion; no qsort on bare-metal targets). */
+static void sort_ascending(double *v, int n)
 {
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    int i, j;
+    for (i = 1; i < n; i++) {
+        const double x = v[i];
+        for (j = i; j > 0 && v[j - 1] > x; j--) v[j] = v[j - 1];
+        v[j] = x;
+    }
 }
 
 /* Share of the regions with points (at least REGION_POINTS) that the motion leaves unexplained:
@@ -46,7 +51,7 @@ static double unexplained_share(double cost[2][2][REGIONS_X * REGIONS_Y],
             per_point[n++] = (cost[0][0][r] < cost[0][1][r] ? cost[0][0][r] : cost[0][1][r]) /
                              count[r];
     if (n < REGIONS_X * REGIONS_Y / 4) return 0.0;
-    qsort(per_point, (size_t)n, sizeof per_point[0], compare_double);
+    sort_ascending(per_point, n);
     median = n % 2 ? per_point[n / 2] : 0.5 * (per_point[n / 2 - 1] + per_point[n / 2]);
     for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
         double cost_h, cost_i;
