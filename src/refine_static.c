@@ -39,28 +39,20 @@ static void sort_ascending(double *v, int n)
 /* Share of the regions with points (at least REGION_POINTS) that the motion leaves unexplained:
  * its mean cost a point over UNEXPLAINED_COST times the median region's, and the identity's
  * at most UNEXPLAINED_IDENTITY times the motion's there (the part of the frame that does not
- * move so: a second motion, or a still background where h follows movers). cost[e][k][r]: the
- * region's summed cost under e (0: h, 1: the identity) with gain and bias k. */
-static double unexplained_share(double cost[2][2][REGIONS_X * REGIONS_Y],
-                                const int *count)
+ * move so: a second motion, or a still background where h follows movers). best[e][r]: the
+ * region's summed cost under e (0: h, 1: the identity), with the better gain and bias. */
+static double unexplained_share(double best[2][REGIONS_X * REGIONS_Y], const int *count)
 {
     double per_point[REGIONS_X * REGIONS_Y], median;
     int r, n = 0, left = 0;
     for (r = 0; r < REGIONS_X * REGIONS_Y; r++)
-        if (count[r] >= REGION_POINTS)
-            per_point[n++] = (cost[0][0][r] < cost[0][1][r] ? cost[0][0][r] : cost[0][1][r]) /
-                             count[r];
+        if (count[r] >= REGION_POINTS) per_point[n++] = best[0][r] / count[r];
     if (n < REGIONS_X * REGIONS_Y / 4) return 0.0;
     sort_ascending(per_point, n);
     median = n % 2 ? per_point[n / 2] : 0.5 * (per_point[n / 2 - 1] + per_point[n / 2]);
-    for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
-        double cost_h, cost_i;
-        if (count[r] < REGION_POINTS) continue;
-        cost_h = cost[0][0][r] < cost[0][1][r] ? cost[0][0][r] : cost[0][1][r];
-        cost_i = cost[1][0][r] < cost[1][1][r] ? cost[1][0][r] : cost[1][1][r];
-        left += cost_h > UNEXPLAINED_COST * median * count[r] &&
-                cost_i <= UNEXPLAINED_IDENTITY * cost_h;
-    }
+    for (r = 0; r < REGIONS_X * REGIONS_Y; r++)
+        left += count[r] >= REGION_POINTS && best[0][r] > UNEXPLAINED_COST * median * count[r] &&
+                best[1][r] <= UNEXPLAINED_IDENTITY * best[0][r];
     return (double)left / n;
 }
 
@@ -76,7 +68,8 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
                                     double *clear_share, int *against, unsigned char *still)
 {
     home__refine_state *st = &ctx->refine;
-    double cost[2][2][REGIONS_X * REGIONS_Y], gain[2], bias[2], hn[9], sigma, c, cost_h, cost_i;
+    double cost[2][2][REGIONS_X * REGIONS_Y], best[2][REGIONS_X * REGIONS_Y];
+    double gain[2], bias[2], hn[9], sigma, c, cost_h, cost_i;
     int count[REGIONS_X * REGIONS_Y], e, i, k, r, votes = 0;
     int wins = 0, clear_votes = 0, clear_wins = 0, fl, n4;
     const unsigned char *faint = st->region_faint[slot]; /* frame A's, as its points */
@@ -128,13 +121,16 @@ double home__refine_identity_share(home_context *ctx, int slot, const double *h,
                 cost[e][k][r] += robust_cost(gain[k] * v + bias[k] - tp->t[i], c);
         }
     }
-    st->unexplained = unexplained_share(cost, count);
+    for (e = 0; e < 2; e++)
+        for (r = 0; r < REGIONS_X * REGIONS_Y; r++)
+            best[e][r] = cost[e][0][r] < cost[e][1][r] ? cost[e][0][r] : cost[e][1][r];
+    st->unexplained = unexplained_share(best, count);
     for (r = 0; r < REGIONS_X * REGIONS_Y; r++) {
         const double apart = faint[r] ? DECISIVE_GREY_FAINT : DECISIVE_GREY;
         const double ratio = faint[r] ? DECISIVE_RATIO_FAINT : DECISIVE_RATIO;
         if (count[r] < REGION_POINTS) continue;
-        cost_h = cost[0][0][r] < cost[0][1][r] ? cost[0][0][r] : cost[0][1][r];
-        cost_i = cost[1][0][r] < cost[1][1][r] ? cost[1][0][r] : cost[1][1][r];
+        cost_h = best[0][r];
+        cost_i = best[1][r];
         if (!faint[r]) {
             votes++;
             wins += cost_i < cost_h;
