@@ -65,6 +65,8 @@ typedef struct home__refine_state {
     int w[HOME_REFINE_MAX_LEVELS], h[HOME_REFINE_MAX_LEVELS];
     uint8_t *pyr[HOME_REFINE_MAX_LEVELS];
     uint32_t pyr_id, slot_id[2];
+    uint32_t keep_id;                 /* a snapshot home__refine_store() does not replace (0:
+                                         none): a frame registered to many, one at a time */
     int next_slot;
     int pending_slot;                 /* its template points not yet selected (deferred), or -1 */
     home__refine_points tpl[2][HOME_REFINE_MAX_LEVELS];
@@ -353,6 +355,9 @@ void home__refine_half_rows(home_context *ctx, const uint8_t *image, ptrdiff_t s
  * defer: its template points are selected only when needed (home__refine_settle), since a
  * frame B is only ever registered to, never from, until another frame is stored. */
 uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int defer);
+/* Keep the snapshot frame_id (0: none) while later frames are stored: each replaces the other
+ * slot, so frame_id can be registered to one frame after another (the stabiliser's key frame). */
+void home__refine_keep(home_context *ctx, uint32_t frame_id);
 /* Select a deferred slot's template points from the pyramid, which is still its frame's (slot:
  * only that slot's; -1: any). Before anything replaces the pyramid or its scratch. */
 void home__refine_settle(home_context *ctx, int slot);

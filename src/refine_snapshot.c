@@ -493,6 +493,11 @@ void home__refine_drop_pending(home_context *ctx)
     st->pending_slot = -1;
 }
 
+void home__refine_keep(home_context *ctx, uint32_t frame_id)
+{
+    ctx->refine.keep_id = frame_id;
+}
+
 uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t stride, int defer)
 {
     home__refine_state *st = &ctx->refine;
@@ -519,7 +524,8 @@ uint32_t home__refine_store(home_context *ctx, const uint8_t *image, ptrdiff_t s
     l = st->levels - 1;
     st->pyr_id = hash_bytes(st->pyr[l], (size_t)st->w[l] * (size_t)st->h[l]);
     slot = st->next_slot;
-    st->next_slot ^= 1;
+    if (st->keep_id && st->slot_id[slot] == st->keep_id) slot ^= 1;
+    st->next_slot = slot ^ 1; /* slot then holds the latest frame, as the refinement expects */
     if (defer)
         st->pending_slot = slot;
     else

@@ -77,7 +77,9 @@ struct home_stab {
     uint8_t *key_luma;            /* the key frame: the last frame whose motion left nothing
                                      unexplained, away from frames that did (key_frame; -1:
                                      none), as registered */
-    long key_frame, last_unexplained;
+    home_features *key_feat;      /* [0] the key frame's features (of key_feat_frame; -1: not
+                                     extracted), [1] the frame registered against it */
+    long key_frame, key_feat_frame, last_unexplained;
     long key_agreed;              /* the last frame whose key registration agreed with the path */
 };
 

@@ -25,6 +25,7 @@
 #define STAB_MAX_SIGMA_PX 4.0
 /* Key frames (key_check(), key_update()): */
 #define STAB_KEY_THETA_BINS 240 /* theta bins of their registration */
+#define STAB_KEY_KEYPOINTS 500  /* keypoints per sign of J in it */
 #define STAB_KEY_MAX_AGE 30     /* frames after the key frame that are registered against it */
 #define STAB_KEY_QUIET 8        /* a frame becomes the key frame only this many frames after
                                    the last one that left a part of the frame unexplained */
@@ -156,7 +157,7 @@ static int ring_length(const home_stab_config *cfg)
 }
 
 typedef struct stab_layout {
-    size_t stab, home, feat, small, ring, key_home, key_luma, total;
+    size_t stab, home, feat, small, ring, key_home, key_luma, key_feat, total;
     size_t home_bytes, key_home_bytes;
 } stab_layout;
 
@@ -168,11 +169,14 @@ static int key_config_for(const home_config *h, home_config *key)
     int status = home_default_config(key, h->width, h->height);
     if (status != HOME_OK) return status;
     key->max_model = HOME_MODEL_SIMILARITY;
-    /* half the bins and a quarter of the points: as accurate past an occluder, cheaper */
+    /* half the bins and keypoints, a quarter of the refinement's points: about as accurate
+     * past an occluder, cheaper (bench/stab/README.md, sessions 27 and 28) */
     key->wrap_band = key->wrap_band * STAB_KEY_THETA_BINS / key->theta_bins;
     key->theta_bins = STAB_KEY_THETA_BINS;
     key->refine_points = STAB_REFINE_POINTS;
     key->refine_finest_level = 1;
+    key->keypoints_per_sign = STAB_KEY_KEYPOINTS;
+    key->fast_pass_downscale = 0; /* features of one image at a time (home_extract) */
     key->simd = h->simd;
     key->clock = h->clock;
     key->clock_user = h->clock_user;
@@ -194,6 +198,7 @@ static void plan(const home_stab_config *cfg, const home_config *h, stab_layout 
         l->key_home_bytes = home_arena_size(&key);
         l->key_home = at; at = align_up(at + l->key_home_bytes);
         l->key_luma = at; at = align_up(at + (size_t)h->width * (size_t)h->height);
+        l->key_feat = at; at = align_up(at + 2 * sizeof(home_features));
     }
     l->total = at;
 }
@@ -245,13 +250,14 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     st->small_h = h.height;
     st->ring = (stab_slot *)(void *)(base + l.ring);
     st->ring_len = ring_length(cfg);
-    st->key_frame = st->last_unexplained = st->key_agreed = -1;
+    st->key_frame = st->key_feat_frame = st->last_unexplained = st->key_agreed = -1;
     if (l.key_home_bytes) {
         home_config key;
         key_config_for(&h, &key);
         status = home_init(&st->key_home, &key, base + l.key_home, l.key_home_bytes, NULL);
         if (status != HOME_OK) return status;
         st->key_luma = base + l.key_luma;
+        st->key_feat = (home_features *)(void *)(base + l.key_feat);
     }
     /* Kalman bandwidth ~ (q/r)^(1/4) per frame for the constant-velocity model */
     st->r = 1.0;
@@ -268,7 +274,7 @@ int home_stab_reset(home_stab *st)
     if (st->magic != STAB_MAGIC) return HOME_E_STATE;
     st->pushed = st->emitted = st->first = 0;
     st->tail = st->cut_requested = 0;
-    st->key_frame = st->last_unexplained = st->key_agreed = -1;
+    st->key_frame = st->key_feat_frame = st->last_unexplained = st->key_agreed = -1;
     return HOME_OK;
 }
 
@@ -590,7 +596,16 @@ static void key_check(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stri
     for (k = n; k > a && !held_for_good(slot_of(st, k)); k--)
         ;
     if (k <= a || k < st->emitted) k = n;
-    if (home_register(st->key_home, st->key_luma, st->small_w, luma, stride, &reg) != HOME_OK)
+    /* the key frame's features and refinement snapshot are extracted once and kept: only
+     * frame n's are new for each frame registered against it */
+    if (st->key_feat_frame != a) {
+        if (home_extract(st->key_home, st->key_luma, st->small_w, &st->key_feat[0]) != HOME_OK)
+            return;
+        home__refine_keep(st->key_home, st->key_feat[0].frame_id);
+        st->key_feat_frame = a;
+    }
+    if (home_extract(st->key_home, luma, stride, &st->key_feat[1]) != HOME_OK ||
+        home_match(st->key_home, &st->key_feat[0], &st->key_feat[1], &reg) != HOME_OK)
         return;
     if (!(reg.ok || reg.refine_status == HOME_REFINE_NOT_CONVERGED) ||
         !plausible_motion(st, &reg, &m_an, &weight))

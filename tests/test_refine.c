@@ -931,6 +931,52 @@ void test_video_equals_pair(void)
     CHECK(!video.refined);
 }
 
+/* A kept snapshot (the stabiliser's key frame): frame a registered to b, then to a later c, each
+ * extracted once, refines as home_register(a, c) does; without the keep, c's snapshot replaces
+ * a's and the refinement has nothing to start from. */
+void test_kept_snapshot(void)
+{
+    static home_features fc;
+    static uint8_t img_c[IMG_W * IMG_H];
+    home_config cfg;
+    home_context *ctx;
+    home_result pair, kept;
+    double h[9], h_c[9];
+    int keep;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.fast_pass_downscale = 0;
+    ctx = context(&cfg);
+    if (!ctx) { CHECK(0); return; }
+    structured_pair(710, 20, h_c);
+    memcpy(img_c, img_b, sizeof img_c);
+    {   /* b: the same scene another way (a is rendered again, the same bytes) */
+        synth_rng rng;
+        synth_seed(&rng, 711);
+        synth_corner_homography(&rng, IMG_W, IMG_H, 15, h);
+        synth_render(SYNTH_STRUCTURED, 710, h, 2.5, 1423, img_b, IMG_W, IMG_H, IMG_W);
+    }
+    CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_c, IMG_W, &pair), HOME_OK);
+    CHECK(pair.ok && pair.refined);
+    for (keep = 1; keep >= 0; keep--) {
+        CHECK_EQ_INT(home_extract(ctx, img_a, IMG_W, &fa), HOME_OK);
+        home__refine_keep(ctx, keep ? fa.frame_id : 0);
+        CHECK_EQ_INT(home_extract(ctx, img_b, IMG_W, &fb), HOME_OK);
+        CHECK_EQ_INT(home_match(ctx, &fa, &fb, &kept), HOME_OK);
+        CHECK(kept.refined);
+        CHECK_EQ_INT(home_extract(ctx, img_c, IMG_W, &fc), HOME_OK);
+        CHECK_EQ_INT(home_match(ctx, &fa, &fc, &kept), HOME_OK);
+        if (keep) {
+            CHECK(kept.ok && kept.refined);
+            CHECK(memcmp(pair.H, kept.H, sizeof pair.H) == 0);
+            CHECK(pair.sigma_px == kept.sigma_px);
+        } else {
+            CHECK_EQ_INT(kept.refine_status, HOME_REFINE_NO_SNAPSHOT);
+        }
+    }
+    home__refine_keep(ctx, 0);
+    CHECK_LT(synth_corner_error(pair.H, h_c, IMG_W, IMG_H), 0.5);
+}
+
 void test_refinement_improves_home(void)
 {
     /* end to end: HOME then refinement on line-only scenes never loses more than 0.5 px and
@@ -1148,7 +1194,7 @@ void test_refine_bad_inputs(void)
 #define TEST_LIST(X) \
     X(kernels_match_references) X(arena_and_config) X(region_grid_exact) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
     X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) X(dense_lens_shading) X(lens_shading_pans_and_tripods) X(few_edges_dim_calibrated) \
-    X(trust_region) X(video_equals_pair) X(refinement_improves_home) X(failure_rule_rescue) \
+    X(trust_region) X(video_equals_pair) X(kept_snapshot) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
 
 #define ENTRY(name) {#name, test_##name},
