@@ -81,6 +81,7 @@ struct home_stab {
                                      extracted), [1] the frame registered against it */
     long key_frame, key_feat_frame, last_unexplained;
     long key_agreed;              /* the last frame whose key registration agreed with the path */
+    long key_failed;              /* the last frame whose key registration failed */
 };
 
 static inline stab_slot *slot_of(const home_stab *st, long frame)

@@ -33,6 +33,8 @@
                                    this far apart (corner px) beyond 3 of its sigma_px, */
 #define STAB_KEY_AGREE_PX 1.0   /* ... and vouches for it within this: the next */
 #define STAB_KEY_TRUSTED 8      /* ... this many frames are not checked */
+#define STAB_KEY_RETRY 4        /* a key registration that fails is tried again only this
+                                   many frames later */
 /* A scene cut: thumbnails correlating below STAB_CUT_SIMILARITY at every shift of up to
  * max_shift (at most STAB_CUT_MAX_SHIFT_CELLS cells, so that most cells are compared) */
 #define STAB_CUT_SIMILARITY 0.5
@@ -250,7 +252,8 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     st->small_h = h.height;
     st->ring = (stab_slot *)(void *)(base + l.ring);
     st->ring_len = ring_length(cfg);
-    st->key_frame = st->key_feat_frame = st->last_unexplained = st->key_agreed = -1;
+    st->key_frame = st->key_feat_frame = st->last_unexplained = -1;
+    st->key_agreed = st->key_failed = -1;
     if (l.key_home_bytes) {
         home_config key;
         key_config_for(&h, &key);
@@ -274,7 +277,8 @@ int home_stab_reset(home_stab *st)
     if (st->magic != STAB_MAGIC) return HOME_E_STATE;
     st->pushed = st->emitted = st->first = 0;
     st->tail = st->cut_requested = 0;
-    st->key_frame = st->key_feat_frame = st->last_unexplained = st->key_agreed = -1;
+    st->key_frame = st->key_feat_frame = st->last_unexplained = -1;
+    st->key_agreed = st->key_failed = -1;
     return HOME_OK;
 }
 
@@ -580,6 +584,7 @@ static void key_check(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stri
     /* the key frame's path must still be in the ring (causal: 11 frames) */
     if (!st->key_home || a < st->first || a >= n || n - a > STAB_KEY_MAX_AGE ||
         (st->key_agreed > a && n - st->key_agreed <= STAB_KEY_TRUSTED) ||
+        (st->key_failed > a && n - st->key_failed < STAB_KEY_RETRY) ||
         n - a >= st->ring_len || slot_of(st, a)->frame != a)
         return;
     /* a camera that moved in most of the decided frames before (else the frame may be a
@@ -592,6 +597,13 @@ static void key_check(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stri
             (s->status == HOME_STAB_MOTION_FAILED && s->has_candidate &&
              i > n - home__stab_still_delay(st)))
             return;
+    }
+    /* the key frame is frame n's predecessor: the part frame n leaves unexplained is new in
+     * it, so the frame's own motion cannot be that part's yet; it vouches as an agreeing key
+     * registration would */
+    if (a == n - 1) {
+        st->key_agreed = n;
+        return;
     }
     for (k = n; k > a && !held_for_good(slot_of(st, k)); k--)
         ;
@@ -608,8 +620,10 @@ static void key_check(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stri
         home_match(st->key_home, &st->key_feat[0], &st->key_feat[1], &reg) != HOME_OK)
         return;
     if (!(reg.ok || reg.refine_status == HOME_REFINE_NOT_CONVERGED) ||
-        !plausible_motion(st, &reg, &m_an, &weight))
+        !plausible_motion(st, &reg, &m_an, &weight)) {
+        st->key_failed = n;
         return;
+    }
     {
         const home_stab_sim inv_a = home__stab_sim_inverse(&slot_of(st, a)->raw);
         chain = home__stab_sim_compose(&slot_of(st, n)->raw, &inv_a);
