@@ -25,7 +25,6 @@
 #define STAB_MAX_SIGMA_PX 4.0
 /* Key frames (key_check(), key_update()): */
 #define STAB_KEY_THETA_BINS 240 /* theta bins of their registration */
-#define STAB_KEY_KEYPOINTS 500  /* keypoints per sign of J in it */
 #define STAB_KEY_MAX_AGE 30     /* frames after the key frame that are registered against it */
 #define STAB_KEY_QUIET 8        /* a frame becomes the key frame only this many frames after
                                    the last one that left a part of the frame unexplained */
@@ -171,13 +170,11 @@ static int key_config_for(const home_config *h, home_config *key)
     int status = home_default_config(key, h->width, h->height);
     if (status != HOME_OK) return status;
     key->max_model = HOME_MODEL_SIMILARITY;
-    /* half the bins and keypoints, a quarter of the refinement's points: about as accurate
-     * past an occluder, cheaper (bench/stab/README.md, sessions 27 and 28) */
+    /* half the bins and a quarter of the points: as accurate past an occluder, cheaper */
     key->wrap_band = key->wrap_band * STAB_KEY_THETA_BINS / key->theta_bins;
     key->theta_bins = STAB_KEY_THETA_BINS;
     key->refine_points = STAB_REFINE_POINTS;
     key->refine_finest_level = 1;
-    key->keypoints_per_sign = STAB_KEY_KEYPOINTS;
     key->fast_pass_downscale = 0; /* features of one image at a time (home_extract) */
     key->simd = h->simd;
     key->clock = h->clock;
