@@ -115,9 +115,10 @@ typedef struct home_stab_config {
                                  a hand at the lens) is also registered against the last frame
                                  before that part appeared, with HOME's still-pair defaults, and
                                  the path follows that registration where the two disagree
-                                 (docs/stabiliser.md). Costs a second HOME context and a frame
-                                 in the arena (640x360: 1.8 -> 4.1 MB) and a registration
-                                 (about 7 ms at 640x360, x86) on such frames; 0: off */
+                                 (docs/stabiliser.md). Costs a second HOME context, a frame
+                                 and two feature sets in the arena (640x360: 1.8 -> 4.0 MB)
+                                 and a full-size Hough transform (5-8 ms at 640x360, x86)
+                                 on such frames; 0: off */
     float max_shift;          /* plausible per-frame translation, fraction of the width */
     float max_rotation;       /* plausible per-frame rotation, radians */
     float max_zoom;           /* plausible per-frame |log scale| */

@@ -82,6 +82,7 @@ struct home_stab {
     long key_frame, key_feat_frame, last_unexplained;
     long key_agreed;              /* the last frame whose key registration agreed with the path */
     long key_failed;              /* the last frame whose key registration failed */
+    long key_apart;               /* the last frame whose key registration the path took */
 };
 
 static inline stab_slot *slot_of(const home_stab *st, long frame)

@@ -34,6 +34,9 @@
 #define STAB_KEY_TRUSTED 8      /* ... this many frames are not checked */
 #define STAB_KEY_RETRY 4        /* a key registration that fails is tried again only this
                                    many frames later */
+#define STAB_KEY_SHARE 0.15     /* a check starts where at least this share of the regions is
+                                   unexplained (a smaller part continues one that found the
+                                   path apart within STAB_KEY_TRUSTED frames) */
 /* A scene cut: thumbnails correlating below STAB_CUT_SIMILARITY at every shift of up to
  * max_shift (at most STAB_CUT_MAX_SHIFT_CELLS cells, so that most cells are compared) */
 #define STAB_CUT_SIMILARITY 0.5
@@ -250,7 +253,7 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     st->ring = (stab_slot *)(void *)(base + l.ring);
     st->ring_len = ring_length(cfg);
     st->key_frame = st->key_feat_frame = st->last_unexplained = -1;
-    st->key_agreed = st->key_failed = -1;
+    st->key_agreed = st->key_failed = st->key_apart = -1;
     if (l.key_home_bytes) {
         home_config key;
         key_config_for(&h, &key);
@@ -275,7 +278,7 @@ int home_stab_reset(home_stab *st)
     st->pushed = st->emitted = st->first = 0;
     st->tail = st->cut_requested = 0;
     st->key_frame = st->key_feat_frame = st->last_unexplained = -1;
-    st->key_agreed = st->key_failed = -1;
+    st->key_agreed = st->key_failed = st->key_apart = -1;
     return HOME_OK;
 }
 
@@ -602,6 +605,11 @@ static void key_check(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stri
         st->key_agreed = n;
         return;
     }
+    /* an object draws HOME's lines to itself only where it covers much of the frame: a
+     * smaller unexplained part (a hand's edge, parallax) starts no check */
+    if (slot_of(st, n)->unexplained < STAB_KEY_SHARE &&
+        !(st->key_apart > a && n - st->key_apart <= STAB_KEY_TRUSTED))
+        return;
     for (k = n; k > a && !held_for_good(slot_of(st, k)); k--)
         ;
     if (k <= a || k < st->emitted) k = n;
@@ -631,7 +639,10 @@ static void key_check(home_stab *st, long n, const uint8_t *luma, ptrdiff_t stri
     }
     d = home__stab_corner_motion(st, &off) - 3.0 * reg.sigma_px * st->cfg.downscale;
     if (d <= STAB_KEY_AGREE_PX) st->key_agreed = n;
-    if (d > STAB_KEY_APART_PX) close_gap(st, a, k, n, 0, &m_an, weight);
+    if (d > STAB_KEY_APART_PX) {
+        st->key_apart = n;
+        close_gap(st, a, k, n, 0, &m_an, weight);
+    }
 }
 
 /* Frame n becomes the key frame when its motion left nothing unexplained and none of the
