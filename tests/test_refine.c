@@ -949,7 +949,7 @@ void test_kept_snapshot(void)
     if (!ctx) { CHECK(0); return; }
     structured_pair(710, 20, h_c);
     memcpy(img_c, img_b, sizeof img_c);
-    {   /* b: the same scene another way (a is rendered again, the same bytes) */
+    {   /* b: the same scene under another motion */
         synth_rng rng;
         synth_seed(&rng, 711);
         synth_corner_homography(&rng, IMG_W, IMG_H, 15, h);
