@@ -178,6 +178,11 @@ static int key_config_for(const home_config *h, home_config *key)
     key->theta_bins = STAB_KEY_THETA_BINS;
     key->refine_points = STAB_REFINE_POINTS;
     key->refine_finest_level = 1;
+    /* the frames' roll prior, in the key's bins: a key registration rotated further is refused
+     * as implausible anyway (plausible_motion()), so matches beyond it need not be tried */
+    key->match_theta_window =
+        (h->match_theta_window * STAB_KEY_THETA_BINS + h->theta_bins - 1) / h->theta_bins;
+    if (key->match_theta_window > STAB_KEY_THETA_BINS) key->match_theta_window = STAB_KEY_THETA_BINS;
     key->fast_pass_downscale = 0; /* features of one image at a time (home_extract) */
     key->simd = h->simd;
     key->clock = h->clock;
