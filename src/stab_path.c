@@ -4,10 +4,25 @@
 #include <string.h>
 
 #define STAB_INIT_VEL_VAR 1.0             /* prior variance of the path velocity, (px/frame)^2 */
+#define STAB_STILL_VAR 1e-6               /* a still frame's path measurement variance, px^2 */
 
 void home__stab_path_components(const home_stab *st, const home_stab_sim *s, double *z)
 {
     z[0] = s->tx; z[1] = s->ty; z[2] = s->angle * st->norm; z[3] = s->log_scale * st->norm;
+}
+
+/* The variance of a frame's path measurement: the intended path plus shake of variance r, more
+ * the less certain the frame's motion. A frame whose camera stood still since the previous one
+ * (registered as the identity, or a small motion taken as none) has no shake: its path is the
+ * intended one, so a tripod shot's still stretches stay still in the output instead of taking
+ * up part of a pan that starts or ends next to them. Only where the lookahead spans the time
+ * constant: the smoother then sees a still frame coming early enough to meet it smoothly, where
+ * a causal or short-sighted path would jump onto it (20 px in one frame at the end of a pan). */
+static double measurement_noise(const home_stab *st, const stab_slot *cur)
+{
+    if (st->still_exact && (cur->registered_still || cur->status == HOME_STAB_MOTION_STILL))
+        return STAB_STILL_VAR;
+    return st->r * cur->weight;
 }
 
 /* One filter step for cur, measuring z (path components). */
@@ -30,7 +45,7 @@ void home__stab_kalman_step(const home_stab *st, const stab_slot *prev, stab_slo
     cur->pp[0] = prev->pf[0] + 2.0 * prev->pf[1] + prev->pf[2] + st->q / 3.0;
     cur->pp[1] = prev->pf[1] + prev->pf[2] + st->q / 2.0;
     cur->pp[2] = prev->pf[2] + st->q;
-    sv = cur->pp[0] + st->r * cur->weight;
+    sv = cur->pp[0] + measurement_noise(st, cur);
     k0 = cur->pp[0] / sv;
     k1 = cur->pp[1] / sv;
     for (c = 0; c < 4; c++) {
@@ -95,6 +110,8 @@ void home__stab_refilter_mirrored_start(const home_stab *st, long first, long la
     long i;
     if (k <= 0) return;
     v[0].weight = v[1].weight = 1.0;
+    v[0].status = v[1].status = HOME_STAB_MOTION_OK;
+    v[0].registered_still = v[1].registered_still = 0;
     path_trend(st, first, first + k, trend);
     for (i = first - k; i <= last; i++) {
         stab_slot *cur = i < first ? &v[(first - i) & 1] : slot_of(st, i);

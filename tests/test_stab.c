@@ -727,6 +727,81 @@ static void test_static_camera_moving_object(void)
     CHECK_LT(worst, 0.05);
 }
 
+/* A tripod shot that pans 3 px a frame over frames 21-34 and stands still before and after it:
+ * the smoothed path of each frame, and its status, with the given lookahead. */
+enum { TRIPOD_FRAMES = 60, TRIPOD_PAN_FROM = 20, TRIPOD_PAN_TO = 34 };
+
+static void run_tripod_pan(int lookahead, home_stab_sim *smooth, int *status)
+{
+    static uint8_t frame[CW * CH * 3 / 2];
+    home_stab *st = make_stab(lookahead, 1, 0);
+    home_stab_output o;
+    home_stab_image im;
+    double pan_x = 0.0;
+    int t, n = 0;
+    CHECK(st != NULL);
+    if (!st) return;
+    for (t = 0; t < TRIPOD_FRAMES + lookahead; t++) {
+        int rc;
+        if (t < TRIPOD_FRAMES) {
+            double h[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+            if (t > TRIPOD_PAN_FROM)
+                pan_x = 3.0 * ((t < TRIPOD_PAN_TO ? t : TRIPOD_PAN_TO) - TRIPOD_PAN_FROM);
+            h[2] = -pan_x;
+            synth_render(SYNTH_STRUCTURED, 9, h, 2.5, (uint64_t)t + 100, frame, CW, CH, CW);
+            memset(frame + CW * CH, 128, CW * CH / 2);
+            grey_image(frame, &im);
+            rc = home_stab_push(st, &im, &o);
+        } else {
+            rc = home_stab_flush(st, &o);
+        }
+        CHECK_EQ_INT(rc, HOME_OK);
+        if (rc == HOME_OK && o.ready && o.frame < TRIPOD_FRAMES) {
+            smooth[o.frame] = o.smooth;
+            status[o.frame] = o.motion_status;
+            n++;
+        }
+    }
+    CHECK_EQ_INT(n, TRIPOD_FRAMES);
+}
+
+/* Output motion from frame t - 1 to t where the raw path stands still: the smoothed path's. */
+static double smoothed_step(const home_stab_sim *smooth, int t)
+{
+    return hypot(smooth[t].tx - smooth[t - 1].tx, smooth[t].ty - smooth[t - 1].ty) +
+           fabs(smooth[t].angle - smooth[t - 1].angle) * CW;
+}
+
+/* With lookahead 15 the still stretches stay still in the output: the smoother used to take up
+ * part of the pan there, easing in over the 15 frames before it started and out after it
+ * stopped (3.4 px by the first frame of a pan on a real clip). Causal, the path cannot see the
+ * end of the pan coming and must not jump onto the still frames after it: it glides on. */
+static void test_tripod_pan_keeps_still_frames(void)
+{
+    static home_stab_sim smooth[TRIPOD_FRAMES];
+    static int status[TRIPOD_FRAMES];
+    double before = 0.0, after = 0.0, causal = 0.0;
+    int t, ok = 0;
+    run_tripod_pan(15, smooth, status);
+    for (t = 1; t < TRIPOD_FRAMES; t++) {
+        ok += status[t] == HOME_STAB_MOTION_OK;
+        if (t <= TRIPOD_PAN_FROM && smoothed_step(smooth, t) > before)
+            before = smoothed_step(smooth, t);
+        if (t > TRIPOD_PAN_TO + 1 && smoothed_step(smooth, t) > after)
+            after = smoothed_step(smooth, t);
+    }
+    run_tripod_pan(0, smooth, status);
+    for (t = TRIPOD_PAN_TO + 1; t < TRIPOD_FRAMES; t++)
+        if (smoothed_step(smooth, t) > causal) causal = smoothed_step(smooth, t);
+    printf("    lookahead 15: %d of %d frames ok, largest output motion a frame %.4f px before "
+           "the pan, %.4f px after it; causal, after it: %.2f px\n", ok, TRIPOD_FRAMES - 1,
+           before, after, causal);
+    CHECK(ok >= TRIPOD_FRAMES - 3);
+    CHECK_LT(before, 0.05);
+    CHECK_LT(after, 0.05);
+    CHECK_LT(causal, 3.0);
+}
+
 /* A tripod shot of fog with textured objects crossing it, a live camera's frames (new noise in
  * every frame): one pair's background is too plain to refute the objects' motion, which HOME
  * then reports ok; the score tests of the frames around, summed, refute most of them, and a
@@ -1184,7 +1259,7 @@ static void test_object_does_not_steer(void)
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
     X(warp_formats_agree) X(warp_bands_match_whole) X(jitter_reduced_causal) X(horizon_in_fog_partial) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
-    X(deterministic) X(static_camera_moving_object) X(static_fog_with_objects) X(cut_restarts_path) X(caller_cut) \
+    X(deterministic) X(static_camera_moving_object) X(tripod_pan_keeps_still_frames) X(static_fog_with_objects) X(cut_restarts_path) X(caller_cut) \
     X(no_cut_on_exposure_or_fade) X(crop_after_the_fact) X(hand_at_lens_followed) X(object_does_not_steer) X(hold_bridged)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
