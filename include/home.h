@@ -260,7 +260,9 @@ enum home_refine_status {
                                      (HOME_FAIL_INCONSISTENT) */
     HOME_REFINE_STILL_REGIONS,    /* a tenth of the regions that clearly decide prefer the
                                      identity: a part of the frame stands still while the
-                                     motion moves the rest, not ok (HOME_FAIL_INCONSISTENT) */
+                                     motion moves the rest, not ok (HOME_FAIL_INCONSISTENT);
+                                     under a max_model cap, also against the homography the
+                                     frame's pixels give (a cap's misfit is not a still part) */
     HOME_REFINE_PERIODIC,         /* a repeated pattern: the motion one period along it fits
                                      about as well, so the pair cannot tell which is right;
                                      sigma_px at least the period, not ok (HOME_FAIL_UNCERTAIN) */

@@ -127,6 +127,10 @@ double home__refine_max_corner_distance(double cx, double cy, const double *h1,
  * entry is h0's); else 0. */
 double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
                         home_result *result);
+/* The same (not patient) as a homography, whatever cfg.max_model caps the answer to: the
+ * motion the frame's pixels give where a capped model misfits them. */
+void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
+                                 home_result *result);
 /* The same (patient), fitting beside the motion a lens falloff fixed to the sensor,
  * s = 1 - kappa rho^2 (rho^2 = 1 at the corners): frames whose background shows one. */
 void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, home_result *result);

@@ -828,7 +828,7 @@ static int run_level(home__refine_solver *s, int level, int max_iterations, int 
  * fills the refine fields of result. */
 static double refine_run(home_context *ctx, int slot, const double *h0,
                          const unsigned char *excluded, const probe_leash *leash, int patient,
-                         int shading, home_result *result)
+                         int shading, int max_model, home_result *result)
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
@@ -843,9 +843,9 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
     /* below a homography the update stays in the model (it is a group: I + D(dp) in it keeps
      * the estimate in it), so a few edges that leave a homography undetermined still fix it */
     s.k = 8;
-    if (ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY) {
+    if (max_model < HOME_MODEL_HOMOGRAPHY) {
         double o[8];
-        s.k = home__model_basis(HOME__SPACE_H, ctx->cfg.max_model, o, s.basis);
+        s.k = home__model_basis(HOME__SPACE_H, max_model, o, s.basis);
     }
     home__refine_to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
@@ -903,7 +903,7 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
         result->refine_status = HOME_REFINE_NOT_LOWER;
         return 0.0;
     }
-    if (!choose_model(&s, ctx->cfg.max_model, h1, result)) {
+    if (!choose_model(&s, max_model, h1, result)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0.0;
     }
@@ -1041,18 +1041,24 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
 double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
                         home_result *result)
 {
-    return refine_run(ctx, slot, h0, NULL, NULL, patient, 0, result);
+    return refine_run(ctx, slot, h0, NULL, NULL, patient, 0, ctx->cfg.max_model, result);
+}
+
+void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
+                                 home_result *result)
+{
+    refine_run(ctx, slot, h0, NULL, NULL, 0, 0, HOME_MODEL_HOMOGRAPHY, result);
 }
 
 void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, home_result *result)
 {
-    refine_run(ctx, slot, h0, NULL, NULL, 1, 1, result);
+    refine_run(ctx, slot, h0, NULL, NULL, 1, 1, ctx->cfg.max_model, result);
 }
 
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,
                                 const unsigned char *excluded, home_result *result)
 {
-    return refine_run(ctx, slot, h0, excluded, NULL, 0, 0, result);
+    return refine_run(ctx, slot, h0, excluded, NULL, 0, 0, ctx->cfg.max_model, result);
 }
 
 void home__refine_probe(home_context *ctx, int slot, const double *h0, const double *back,
@@ -1061,5 +1067,5 @@ void home__refine_probe(home_context *ctx, int slot, const double *h0, const dou
     probe_leash leash;
     leash.back = back;
     leash.radius = radius;
-    refine_run(ctx, slot, h0, NULL, &leash, 0, 0, result);
+    refine_run(ctx, slot, h0, NULL, &leash, 0, 0, ctx->cfg.max_model, result);
 }
