@@ -173,11 +173,10 @@ int home__refine_score_refutes(double observed, double expected, double evidence
 
 /* Under a model cap (the stabiliser asks for a similarity), the regions a change of perspective
  * moves least can prefer the identity to the capped motion while the frame's homography moves
- * them all (a camera travelling over a table: visp's cube, 17 of 79 pairs refused as two
- * motions). 1 when the homography refined from the capped answer leaves less than
- * TWO_MOTIONS_SHARE of the clearly decided regions to the identity: one motion the cap cannot
- * follow, not a part of the frame standing still. The unexplained share is then the
- * homography's. */
+ * them all (a camera travelling over a table). 1 when the homography refined from the capped
+ * answer leaves less than TWO_MOTIONS_SHARE of the clearly decided regions to the identity: one
+ * motion the cap cannot follow, not a part of the frame standing still. The unexplained share
+ * is then the homography's. */
 static int cap_misfit_only(home_context *ctx, int slot, const home_result *trial)
 {
     home_result full = *trial;

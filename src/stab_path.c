@@ -17,7 +17,7 @@ void home__stab_path_components(const home_stab *st, const home_stab_sim *s, dou
  * intended one, so a tripod shot's still stretches stay still in the output instead of taking
  * up part of a pan that starts or ends next to them. Only where the lookahead spans the time
  * constant: the smoother then sees a still frame coming early enough to meet it smoothly, where
- * a causal or short-sighted path would jump onto it (20 px in one frame at the end of a pan). */
+ * a causal or short-sighted path would jump onto it at the end of a pan. */
 static double measurement_noise(const home_stab *st, const stab_slot *cur)
 {
     if (st->still_exact && (cur->registered_still || cur->status == HOME_STAB_MOTION_STILL))
