@@ -774,7 +774,7 @@ static double smoothed_step(const home_stab_sim *smooth, int t)
 
 /* With lookahead 15 the still stretches stay still in the output: the smoother used to take up
  * part of the pan there, easing in over the 15 frames before it started and out after it
- * stopped (3.4 px by the first frame of a pan on a real clip). Causal, the path cannot see the
+ * stopped (2.7 px before the first frame of a move on a real clip). Causal, the path cannot see the
  * end of the pan coming and must not jump onto the still frames after it: it glides on. */
 static void test_tripod_pan_keeps_still_frames(void)
 {
