@@ -34,7 +34,7 @@ $(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) -fsanitize=fuzzer $< $(FUZZ_SUPPORT) $(LIB) -o $@ $(LDFLAGS_APP)
 
-# FUZZ_SECONDS per target, one after the other (FUZZ_TARGET=api picks one).
+# FUZZ_SECONDS per target, as many side by side as there are cores (FUZZ_TARGET=api picks one).
 fuzz: fuzz-build
 	FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) bash tests/fuzz/run.sh $(or $(FUZZ_TARGET),$(FUZZ_TARGETS))
 
@@ -42,14 +42,21 @@ fuzz: fuzz-build
 LINT_SRC := $(wildcard src/*.c port/*.c port/*/*.c)
 # ctuuninitvar in extrema.c: the heap probe sets only the two fields ranks_below() reads
 LINT_SUPPRESS := --suppress=ctuuninitvar:src/extrema.c
-lint:
+# cppcheck over all files in one run (its checks cross files), gcc -fanalyzer file by file: with
+# make -j, side by side
+LINT_OBJ := $(patsubst %.c,$(BUILD)/lint/%.o,$(LINT_SRC))
+.PHONY: lint-cppcheck FORCE
+FORCE:
+lint: lint-cppcheck $(LINT_OBJ)
+	@echo "lint: cppcheck and gcc -fanalyzer clean on $(words $(LINT_SRC)) files"
+
+lint-cppcheck:
 	cppcheck --std=c99 --enable=warning,portability,performance --error-exitcode=1 --quiet \
 		--inline-suppr $(LINT_SUPPRESS) -Iinclude -Isrc -Iport $(LINT_SRC)
-	@mkdir -p $(BUILD)/lint
-	set -e; for f in $(LINT_SRC); do \
-		gcc -std=c99 -O2 $(WARN) -Iinclude -Isrc -Iport -fanalyzer -Wno-analyzer-too-complex \
-			-c $$f -o $(BUILD)/lint/$$(basename $$f .c).o; done
-	@echo "lint: cppcheck and gcc -fanalyzer clean on $(words $(LINT_SRC)) files"
+
+$(BUILD)/lint/%.o: %.c FORCE
+	@mkdir -p $(dir $@)
+	gcc -std=c99 -O2 $(WARN) -Iinclude -Isrc -Iport -fanalyzer -Wno-analyzer-too-complex -c $< -o $@
 
 # --- stack --------------------------------------------------------------------------------
 STACK_BUILD ?= build-stack
@@ -67,14 +74,27 @@ VALGRIND ?= valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kind
 	--show-leak-kinds=all -q
 VALGRIND_TESTS := bad_input_table refusals_leave_context_usable fails_constant_and_noise \
 	fails_single_edge fails_unrelated_scenes output_independent_of_arena_and_layout
-valgrind: all
-	$(VALGRIND) $(HARD_TESTS) $(VALGRIND_TESTS)
+# The parts run side by side under make -j: the two long tests of the table (about 25 s each
+# under memcheck) apart from the rest.
+VALGRIND_PARTS := valgrind-table valgrind-unrelated valgrind-tests valgrind-replay valgrind-cli
+.PHONY: $(VALGRIND_PARTS)
+valgrind: $(VALGRIND_PARTS)
+	@echo "valgrind: memcheck clean (0 errors, 0 leaks)"
+
+$(VALGRIND_PARTS): all
+valgrind-table:
+	$(VALGRIND) $(HARD_TESTS) bad_input_table
+valgrind-unrelated:
+	$(VALGRIND) $(HARD_TESTS) fails_unrelated_scenes
+valgrind-tests:
+	$(VALGRIND) $(HARD_TESTS) $(filter-out bad_input_table fails_unrelated_scenes,$(VALGRIND_TESTS))
+valgrind-replay:
 	set -e; for t in $(FUZZ_TARGETS); do \
 		$(VALGRIND) $(FUZZ_REPLAY) $$t $$(ls tests/fuzz/corpus/$$t/seed-* tests/fuzz/corpus/$$t/regress-* 2> /dev/null) > /dev/null; done
+valgrind-cli:
 	@mkdir -p $(BUILD)/valgrind
 	$(BUILD)/bin/home-make-pair --width 160 --height 120 $(BUILD)/valgrind/a.pgm $(BUILD)/valgrind/b.pgm > /dev/null
 	$(VALGRIND) $(BUILD)/bin/home-register $(BUILD)/valgrind/a.pgm $(BUILD)/valgrind/b.pgm
 	head -c 1000 $(BUILD)/valgrind/a.pgm > $(BUILD)/valgrind/truncated.pgm
 	$(VALGRIND) $(BUILD)/bin/home-register $(BUILD)/valgrind/truncated.pgm $(BUILD)/valgrind/b.pgm; \
 		test $$? -eq 2
-	@echo "valgrind: memcheck clean (0 errors, 0 leaks)"

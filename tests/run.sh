@@ -14,19 +14,36 @@ trap 'rm -rf "$tmp"' EXIT
 ok() { passed=$((passed + 1)); echo "ok   $1"; }
 fail() { failed=$((failed + 1)); echo "FAIL $1${2:+: $2}"; }
 
-# 1. test binaries (unit, end-to-end; areas add theirs to TEST_BINS in mk/*.mk)
-for bin in ${TEST_BINS:-$BUILD/bin/home-tests}; do
-  name=$(basename "$bin")
-  $RUNNER "$bin" > "$tmp/unit.out"
-  unit_status=$?
-  cat "$tmp/unit.out"
-  line=$(tail -n 1 "$tmp/unit.out")
-  if [[ $line =~ ^([0-9]+)\ passed,\ ([0-9]+)\ failed$ ]]; then
-    passed=$((passed + BASH_REMATCH[1])); failed=$((failed + BASH_REMATCH[2]))
-    [ "$unit_status" -eq 0 ] || [ "${BASH_REMATCH[2]}" -gt 0 ] || fail "$name" "exit status $unit_status"
-  else
-    fail "$name" "crashed or printed no summary (exit status $unit_status)"
-  fi
+# 1. test binaries (unit, end-to-end; areas add theirs to TEST_BINS in mk/*.mk). TEST_JOBS
+#    processes (default: the online cores, at most 4) each run every binary's k-th share of the
+#    cases (HOME_TEST_SHARD); the outputs are printed binary by binary once all are done.
+jobs=${TEST_JOBS:-$(getconf _NPROCESSORS_ONLN 2> /dev/null || echo 1)}
+[[ $jobs =~ ^[1-9][0-9]*$ ]] || jobs=1
+[ "$jobs" -gt 4 ] && [ -z "${TEST_JOBS:-}" ] && jobs=4
+bins=(${TEST_BINS:-$BUILD/bin/home-tests})
+for ((k = 0; k < jobs; k++)); do
+  (for i in "${!bins[@]}"; do
+     HOME_TEST_SHARD="$k/$jobs" $RUNNER "${bins[$i]}" > "$tmp/unit.$i.$k.out" 2> "$tmp/unit.$i.$k.err"
+     echo $? > "$tmp/unit.$i.$k.status"
+   done) &
+done
+wait
+for i in "${!bins[@]}"; do
+  name=$(basename "${bins[$i]}")
+  for ((k = 0; k < jobs; k++)); do
+    out="$tmp/unit.$i.$k"
+    head -n -1 "$out.out"
+    cat "$out.err" >&2
+    line=$(tail -n 1 "$out.out")
+    unit_status=$(cat "$out.status")
+    if [[ $line =~ ^([0-9]+)\ passed,\ ([0-9]+)\ failed$ ]]; then
+      passed=$((passed + BASH_REMATCH[1])); failed=$((failed + BASH_REMATCH[2]))
+      [ "$unit_status" -eq 0 ] || [ "${BASH_REMATCH[2]}" -gt 0 ] || fail "$name" "exit status $unit_status"
+    else
+      fail "$name" "crashed or printed no summary (exit status $unit_status, share $k/$jobs)"
+      tail -n 1 "$out.out"
+    fi
+  done
 done
 
 # 2. the library is allocation-free and has no writable globals

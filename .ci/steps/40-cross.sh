@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Cross builds for Raspberry Pi-class targets; the suite runs under qemu-user, so NEON is
 # checked bit for bit against the scalar reference on aarch64 and armv7. The two targets run
-# side by side (qemu is single-threaded; CI has 2 cores). Under emulation the long accuracy tests
-# of tests/cross-skip.txt are left to the native runs, and the golden check adds the demo clip.
+# side by side, each test binary in two shares (tests/run.sh, TEST_JOBS): qemu is
+# single-threaded, and the shorter aarch64 run leaves both cores to armv7 when it is done. Under
+# emulation the long accuracy tests of tests/cross-skip.txt are left to the native runs, and the
+# golden check adds the demo clip.
 set -euo pipefail
 SUDO=""
 [ "$(id -u)" -ne 0 ] && SUDO=sudo
@@ -10,7 +12,7 @@ $SUDO apt-get install -y -qq --no-install-recommends gcc-aarch64-linux-gnu gcc-a
   libc6-dev-arm64-cross libc6-dev-armhf-cross qemu-user-static binutils-aarch64-linux-gnu \
   binutils-arm-linux-gnueabihf > /dev/null
 HOME_TEST_SKIP=$(sed 's/#.*//' tests/cross-skip.txt)
-export HOME_TEST_SKIP GOLDEN_CLIP=1
+export HOME_TEST_SKIP GOLDEN_CLIP=1 TEST_JOBS=2
 pids=()
 for target in aarch64-linux-gnu arm-linux-gnueabihf; do
   mkdir -p build-$target

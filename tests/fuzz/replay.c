@@ -84,9 +84,18 @@ static int replay_dir(fuzz_fn fn, const char *dir)
 int main(int argc, char **argv)
 {
     const char *root = getenv("HOME_FUZZ_CORPUS");
+    const char *shard_text = getenv("HOME_TEST_SHARD");
+    unsigned shard = 0, shards = 1;
     size_t t;
     int passed = 0, failed = 0, k;
     if (!root) root = "tests/fuzz/corpus";
+    /* HOME_TEST_SHARD "k/n": every n-th target from the k-th, as tests/support/test_runner.c */
+    if (shard_text && *shard_text &&
+        (sscanf(shard_text, "%u/%u", &shard, &shards) != 2 || shards == 0 || shard >= shards)) {
+        fprintf(stderr, "HOME_TEST_SHARD must be k/n with 0 <= k < n\n");
+        printf("0 passed, 1 failed\n");
+        return 1;
+    }
     if (argc >= 3) {
         for (t = 0; t < sizeof targets / sizeof targets[0]; t++) {
             if (strcmp(argv[1], targets[t].name)) continue;
@@ -103,6 +112,7 @@ int main(int argc, char **argv)
     for (t = 0; t < sizeof targets / sizeof targets[0]; t++) {
         char dir[4096];
         int n;
+        if (t % shards != shard) continue;
         n = snprintf(dir, sizeof dir, "%s/%s", root, targets[t].name) < (int)sizeof dir
             ? replay_dir(targets[t].fn, dir) : -1;
         if (n > 0) { passed++; printf("ok   fuzz_replay_%s (%d inputs)\n", targets[t].name, n); }
