@@ -1,10 +1,9 @@
 #!/usr/bin/env bash
 # Cross builds for Raspberry Pi-class targets; the suite runs under qemu-user, so NEON is
 # checked bit for bit against the scalar reference on aarch64 and armv7. The two targets run
-# side by side, each test binary in two shares (tests/run.sh, TEST_JOBS): qemu is
-# single-threaded, and the shorter aarch64 run leaves both cores to armv7 when it is done. Under
-# emulation the long accuracy tests of tests/cross-skip.txt are left to the native runs, and the
-# golden check adds the demo clip.
+# side by side, each test binary in two shares (tests/run.sh, TEST_JOBS; qemu is
+# single-threaded and CI has 2 cores). Under emulation the long accuracy tests of
+# tests/cross-skip.txt are left to the native runs, and the golden check adds the demo clip.
 set -euo pipefail
 SUDO=""
 [ "$(id -u)" -ne 0 ] && SUDO=sudo
