@@ -49,7 +49,7 @@ $(BUILD)/obj/fuzz-replay/replay.o: tests/fuzz/replay.c $(MAKEFILE_LIST)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $(DEPFLAGS) '-DFUZZ_TARGETS(X)=$(FUZZ_TARGET_LIST)' -c $< -o $@
 
-$(FUZZ_REPLAY): $(BUILD)/obj/fuzz-replay/replay.o $(FUZZ_REPLAY_OBJ) $(FUZZ_SUPPORT) $(LIB)
+$(FUZZ_REPLAY): $(BUILD)/obj/fuzz-replay/replay.o $(FUZZ_REPLAY_OBJ) $(RUNNER_OBJ) $(FUZZ_SUPPORT) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_APP) $^ -o $@ $(LDFLAGS_APP)
 

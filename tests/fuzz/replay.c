@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "test.h"
 
 /* Each harness is compiled with LLVMFuzzerTestOneInput renamed (see mk/hardening.mk). */
 typedef int (*fuzz_fn)(const uint8_t *data, size_t size);
@@ -84,14 +85,12 @@ static int replay_dir(fuzz_fn fn, const char *dir)
 int main(int argc, char **argv)
 {
     const char *root = getenv("HOME_FUZZ_CORPUS");
-    const char *shard_text = getenv("HOME_TEST_SHARD");
-    unsigned shard = 0, shards = 1;
+    unsigned shard, shards;
     size_t t;
     int passed = 0, failed = 0, k;
     if (!root) root = "tests/fuzz/corpus";
-    /* HOME_TEST_SHARD "k/n": every n-th target from the k-th, as tests/support/test_runner.c */
-    if (shard_text && *shard_text &&
-        (sscanf(shard_text, "%u/%u", &shard, &shards) != 2 || shards == 0 || shard >= shards)) {
+    /* HOME_TEST_SHARD: every n-th target from the k-th (test.h) */
+    if (test_shard(&shard, &shards) < 0) {
         fprintf(stderr, "HOME_TEST_SHARD must be k/n with 0 <= k < n\n");
         printf("0 passed, 1 failed\n");
         return 1;

@@ -19,7 +19,7 @@ fuzz_target() {
   local corpus=$FUZZ_BUILD/corpus/$target
   local log=$FUZZ_BUILD/logs/$target.log
   local dict st execs speed units
-  mkdir -p "$corpus" "$FUZZ_BUILD/crashes" "$FUZZ_BUILD/logs"
+  mkdir -p "$corpus" "$FUZZ_BUILD/crashes"
   dict=()
   [ -f "tests/fuzz/$target.dict" ] && dict=(-dict="tests/fuzz/$target.dict")
   # -timeout: one input taking over 10 s is a hang; -rss_limit_mb: a leak or runaway allocation

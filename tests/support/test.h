@@ -18,6 +18,10 @@ typedef struct test_case { const char *name; void (*fn)(void); } test_case;
 /* Run the cases named on the command line (all without arguments), print one line each with the
  * prefix, then "N passed, N failed"; returns the exit status. tests/support/test_runner.c. */
 int test_run(const test_case *cases, size_t n, const char *prefix, int argc, char **argv);
+/* HOME_TEST_SHARD "k/n" (0 <= k < n): this process runs every n-th of the cases, starting at
+ * the k-th, so n processes share a binary's cases (tests/run.sh, TEST_JOBS). Sets k = 0, n = 1
+ * when it is unset; -1 when it is malformed. */
+int test_shard(unsigned *k, unsigned *n);
 #define CHECK(cond) do { if (!(cond)) { test_failures++; \
     fprintf(stderr, "    %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
 #define CHECK_EQ_INT(a, b) do { long long a_ = (long long)(a), b_ = (long long)(b); if (a_ != b_) { \

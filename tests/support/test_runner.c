@@ -20,12 +20,13 @@ static int listed(const char *list, const char *prefix, const char *name)
     return 0;
 }
 
-/* HOME_TEST_SHARD "k/n" (0 <= k < n): this process runs every n-th of the cases, starting at
- * the k-th, so n processes run a binary's cases side by side (tests/run.sh, TEST_JOBS) */
-static int parse_shard(const char *text, unsigned *k, unsigned *n)
+int test_shard(unsigned *k, unsigned *n)
 {
+    const char *text = getenv("HOME_TEST_SHARD");
     char *end;
     unsigned long a, b;
+    *k = 0;
+    *n = 1;
     if (!text || !*text) return 0;
     a = strtoul(text, &end, 10);
     if (*end != '/') return -1;
@@ -33,7 +34,7 @@ static int parse_shard(const char *text, unsigned *k, unsigned *n)
     if (*end || b == 0 || a >= b) return -1;
     *k = (unsigned)a;
     *n = (unsigned)b;
-    return 1;
+    return 0;
 }
 
 int test_run(const test_case *cases, size_t n, const char *prefix, int argc, char **argv)
@@ -44,7 +45,7 @@ int test_run(const test_case *cases, size_t n, const char *prefix, int argc, cha
     int passed = 0, failed = 0, skipped = 0;
     unsigned shard = 0, shards = 1, position = 0;
     size_t i;
-    if (argc < 2 && parse_shard(getenv("HOME_TEST_SHARD"), &shard, &shards) < 0) {
+    if (argc < 2 && test_shard(&shard, &shards) < 0) {
         fprintf(stderr, "HOME_TEST_SHARD must be k/n with 0 <= k < n\n");
         printf("0 passed, 1 failed\n");
         return 1;
