@@ -318,6 +318,9 @@ typedef struct home__model_problem {
     int max_model;               /* enum home_model: the caller's cap */
     int max_params;              /* models with more parameters are not determined by the data */
     double scale, cx, cy;        /* pixel = scale * normalised + (cx, cy) */
+    double floor_px;             /* > 0: the choice weighs each model's misfit as if every
+                                    corner coordinate also carried this much error of its own
+                                    (space H only) */
 } home__model_problem;
 typedef struct home__model_choice {
     int model;                   /* enum home_model */

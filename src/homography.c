@@ -146,6 +146,7 @@ static void choose_model(home_context *ctx, home__line_problem *lp, int n_in, do
     /* n_in observations carry the information of `distinct` independent ones */
     var *= LINE_SIGMA_SCALE * LINE_SIGMA_SCALE * n_in / (distinct > 0 ? distinct : 1);
     mp.space = HOME__SPACE_G;
+    mp.floor_px = 0.0;
     memcpy(mp.p, g, sizeof mp.p);
     for (k = 0; k < 64; k++) mp.info[k] = jtj[k] / var;
     mp.penalty = log(2.0 * (distinct > 0 ? distinct : 1));

@@ -11,6 +11,13 @@
  * invertible, so a scene whose lines leave a homography undetermined still gets the similarity
  * or translation they do fix.
  *
+ * A fit's information sees independent noise, not errors its observations share (the photometric
+ * refinement on the few edges of a dim frame: homographies 1-2 px off at a predicted 0.2 px,
+ * their halves agreeing). With floor_px > 0 a homography chosen over the plain information must
+ * also win with floor_px of error added to each corner coordinate, (F^-1 + J^-1 floor^2
+ * J^-T)^-1 with J the corners' Jacobian; otherwise the best simpler model by that measure
+ * stands, and its predicted error holds the perspective it leaves out, as below.
+ *
  * Spaces: the refinement's p are the homography's entries h0..h7 (h8 = 1) in normalised
  * coordinates; the line fit's are G = H^-T's. A model keeps the same form in both, except that the
  * translation and the perspective entries trade places: H = [A t; 0 1] has G = [A^-T 0; -(A^-1 t)^T
@@ -191,79 +198,197 @@ static double model_sigma(const home__model_problem *mp, const double basis[8][8
     return sqrt(var / 4.0); /* RMS over the four corners of the 2-D error */
 }
 
+/* The inverse of the 8x8 matrix a (destroyed) by Gauss-Jordan with partial pivoting; 0 when
+ * singular. */
+static int invert8(double *a, double *inv)
+{
+    int i, j, r, c;
+    for (i = 0; i < 64; i++) inv[i] = i % 9 == 0 ? 1.0 : 0.0;
+    for (c = 0; c < 8; c++) {
+        int pivot = c;
+        double d;
+        for (r = c + 1; r < 8; r++)
+            if (fabs(a[r * 8 + c]) > fabs(a[pivot * 8 + c])) pivot = r;
+        if (!(fabs(a[pivot * 8 + c]) > 1e-300)) return 0;
+        for (j = 0; j < 8; j++) {
+            double t = a[c * 8 + j];
+            a[c * 8 + j] = a[pivot * 8 + j];
+            a[pivot * 8 + j] = t;
+            t = inv[c * 8 + j];
+            inv[c * 8 + j] = inv[pivot * 8 + j];
+            inv[pivot * 8 + j] = t;
+        }
+        d = a[c * 8 + c];
+        for (j = 0; j < 8; j++) {
+            a[c * 8 + j] /= d;
+            inv[c * 8 + j] /= d;
+        }
+        for (r = 0; r < 8; r++) {
+            const double f = a[r * 8 + c];
+            if (r == c || f == 0.0) continue;
+            for (j = 0; j < 8; j++) {
+                a[r * 8 + j] -= f * a[c * 8 + j];
+                inv[r * 8 + j] -= f * inv[c * 8 + j];
+            }
+        }
+    }
+    return 1;
+}
+
+/* The information `info` with floor_px of independent error added to each corner coordinate:
+ * in corner coordinates c = J p, F_c = J^-T F J^-1 becomes (F_c^-1 + floor^2 I)^-1 =
+ * F_c (I + floor^2 F_c)^-1, then back, J^T F_c' J. 0 when J is singular. */
+static int floored_information(const home__model_problem *mp, double *out)
+{
+    double cj[8][8], a[64], jinv[64], fc[64], t[64], l[64];
+    const double f2 = mp->floor_px * mp->floor_px;
+    int i, j, k;
+    corner_jacobian(mp->p, mp->scale, mp->cx, mp->cy, cj);
+    for (i = 0; i < 8; i++)
+        for (j = 0; j < 8; j++) a[i * 8 + j] = cj[i][j];
+    if (!invert8(a, jinv)) return 0;
+    for (i = 0; i < 8; i++) /* t = F J^-1, fc = J^-T t */
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (k = 0; k < 8; k++) v += mp->info[i * 8 + k] * jinv[k * 8 + j];
+            t[i * 8 + j] = v;
+        }
+    for (i = 0; i < 8; i++)
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (k = 0; k < 8; k++) v += jinv[k * 8 + i] * t[k * 8 + j];
+            fc[i * 8 + j] = v;
+        }
+    for (i = 0; i < 64; i++) l[i] = f2 * 0.5 * (fc[i] + fc[(i % 8) * 8 + i / 8]) + (i % 9 == 0);
+    if (!home__cholesky8(l)) return 0;
+    for (j = 0; j < 8; j++) { /* t = (I + floor^2 F_c)^-1 F_c, column by column: F_c' = t^T */
+        double col[8];
+        for (i = 0; i < 8; i++) col[i] = fc[i * 8 + j];
+        home__cholesky_solve8(l, col);
+        for (i = 0; i < 8; i++) t[i * 8 + j] = col[i];
+    }
+    for (i = 0; i < 8; i++) /* fc = F_c' J, out = J^T fc */
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (k = 0; k < 8; k++) v += t[k * 8 + i] * cj[k][j];
+            fc[i * 8 + j] = v;
+        }
+    for (i = 0; i < 8; i++)
+        for (j = 0; j < 8; j++) {
+            double v = 0.0;
+            for (k = 0; k < 8; k++) v += cj[k][i] * fc[k * 8 + j];
+            out[i * 8 + j] = v;
+        }
+    return 1;
+}
+
+/* n_mat = B^T F B and rhs = B^T F (p - o) of a model's subspace (k x k, row stride 8). */
+static void projected_normal(const home__model_problem *mp, const double basis[8][8], int k,
+                             const double *o, double *n_mat, double *rhs)
+{
+    double fd[8];
+    int i, j, a, b;
+    memset(n_mat, 0, 64 * sizeof *n_mat);
+    memset(rhs, 0, 8 * sizeof *rhs);
+    for (i = 0; i < 8; i++) {
+        double s = 0.0;
+        for (j = 0; j < 8; j++) s += mp->info[i * 8 + j] * (mp->p[j] - o[j]);
+        fd[i] = s;
+    }
+    for (i = 0; i < k; i++) {
+        double s = 0.0;
+        for (j = 0; j < 8; j++) s += basis[i][j] * fd[j];
+        rhs[i] = s;
+        for (j = 0; j < k; j++) {
+            double t = 0.0;
+            for (a = 0; a < 8; a++) {
+                if (basis[i][a] == 0.0) continue;
+                for (b = 0; b < 8; b++) t += basis[i][a] * mp->info[a * 8 + b] * basis[j][b];
+            }
+            n_mat[i * 8 + j] = t;
+        }
+    }
+}
+
+/* d^T m d (8 x 8). */
+static double quadratic8(const double *d, const double *m)
+{
+    double v = 0.0;
+    int i, j;
+    for (i = 0; i < 8; i++)
+        for (j = 0; j < 8; j++) v += d[i] * m[i * 8 + j] * d[j];
+    return v;
+}
+
 int home__select_model(const home__model_problem *mp, home__model_choice *out)
 {
-    double basis[8][8], o[8], best_basis[8][8], best_n[64], general_p[8];
-    int model, i, j, best = -1, best_k = 0, general = -1;
+    enum { MODELS = HOME_MODEL_HOMOGRAPHY + 1 };
+    double basis[8][8], o[8], n_mat[64], rhs[8], weigh[64];
+    double p_of[MODELS][8], delta_of[MODELS], floored_of[MODELS];
+    int k_of[MODELS], model, i, j, best = -1, general = -1;
     double best_score = INFINITY;
 
     out->model = -1;
     out->sigma_px = INFINITY;
+    if (mp->floor_px > 0.0 && mp->space == HOME__SPACE_H && !floored_information(mp, weigh))
+        return 0;
     for (model = HOME_MODEL_IDENTITY; model <= mp->max_model; model++) {
-        double n_mat[64] = {0}, rhs[8] = {0}, q[8], diff[8], fd[8], p[8], delta = 0.0, score;
+        double q[8], diff[8], a_copy[64];
         const int k = home__model_basis(mp->space, model, o, basis);
+        k_of[model] = -1; /* not determined by the data */
         if (k > mp->max_params) break;
         /* q = (B^T F B)^-1 B^T F (p - o) */
-        for (i = 0; i < 8; i++) {
-            double s = 0.0;
-            for (j = 0; j < 8; j++) s += mp->info[i * 8 + j] * (mp->p[j] - o[j]);
-            fd[i] = s;
-        }
-        for (i = 0; i < k; i++) {
-            double s = 0.0;
-            for (j = 0; j < 8; j++) s += basis[i][j] * fd[j];
-            rhs[i] = s;
-            for (j = 0; j < k; j++) {
-                double t = 0.0;
-                int a, b;
-                for (a = 0; a < 8; a++) {
-                    if (basis[i][a] == 0.0) continue;
-                    for (b = 0; b < 8; b++) t += basis[i][a] * mp->info[a * 8 + b] * basis[j][b];
-                }
-                n_mat[i * 8 + j] = t;
-            }
-        }
-        {
-            double a_copy[64];
-            memcpy(a_copy, n_mat, sizeof a_copy);
-            memcpy(q, rhs, sizeof q);
-            if (k > 0 && !home__solve_spd(a_copy, q, k)) continue; /* not determined by the data */
-        }
-        memcpy(p, o, sizeof o);
+        projected_normal(mp, (const double (*)[8])basis, k, o, n_mat, rhs);
+        memcpy(a_copy, n_mat, sizeof a_copy);
+        memcpy(q, rhs, sizeof q);
+        if (k > 0 && !home__solve_spd(a_copy, q, k)) continue;
+        memcpy(p_of[model], o, sizeof o);
         for (i = 0; i < k; i++)
-            for (j = 0; j < 8; j++) p[j] += q[i] * basis[i][j];
-        for (i = 0; i < 8; i++) diff[i] = p[i] - mp->p[i];
-        for (i = 0; i < 8; i++)
-            for (j = 0; j < 8; j++) delta += diff[i] * mp->info[i * 8 + j] * diff[j];
-        if (!isfinite(delta)) continue;
-        score = delta + mp->penalty * k;
+            for (j = 0; j < 8; j++) p_of[model][j] += q[i] * basis[i][j];
+        for (i = 0; i < 8; i++) diff[i] = p_of[model][i] - mp->p[i];
+        delta_of[model] = quadratic8(diff, mp->info);
+        if (!isfinite(delta_of[model])) continue;
+        floored_of[model] = mp->floor_px > 0.0 && mp->space == HOME__SPACE_H
+                                ? quadratic8(diff, weigh) : delta_of[model];
+        k_of[model] = k;
         general = model; /* the most general determined model so far */
-        memcpy(general_p, p, sizeof general_p);
-        if (score < best_score) {
-            best_score = score;
+        if (delta_of[model] + mp->penalty * k < best_score) {
+            best_score = delta_of[model] + mp->penalty * k;
             best = model;
-            best_k = k;
-            memcpy(best_basis, basis, sizeof best_basis);
-            memcpy(best_n, n_mat, sizeof best_n);
-            memcpy(out->p, p, sizeof p);
-            out->model = model;
-            out->delta = delta;
         }
     }
     if (best < 0) return 0;
+    /* a homography must also stand out of the corners' error floor: a translation, similarity
+     * or affine takes its place when it scores lower with the floor (not the identity: a small
+     * motion does not become none because of a floor) */
+    if (best == HOME_MODEL_HOMOGRAPHY && mp->floor_px > 0.0) {
+        double floored_best = mp->penalty * k_of[best];
+        const int chosen = best;
+        for (model = HOME_MODEL_TRANSLATION; model < HOME_MODEL_HOMOGRAPHY; model++)
+            if (k_of[model] >= 0 && floored_of[model] + mp->penalty * k_of[model] < floored_best) {
+                floored_best = floored_of[model] + mp->penalty * k_of[model];
+                best = model;
+            }
+        if (best != chosen) delta_of[best] = floored_of[best];
+    }
+    memcpy(out->p, p_of[best], sizeof out->p);
+    out->model = best;
+    out->delta = delta_of[best];
     /* the chosen model must explain the data no worse than an exact homography would, at its
      * cost in parameters (matters when the homography is undetermined); a cap below the
      * homography asks for the best such model whatever its misfit */
     if (best < HOME_MODEL_HOMOGRAPHY && mp->max_model == HOME_MODEL_HOMOGRAPHY &&
-        !(out->delta <= mp->penalty * (8 - best_k)))
+        !(out->delta <= mp->penalty * (8 - k_of[best])))
         return 0;
-    out->sigma_px = model_sigma(mp, (const double (*)[8])best_basis, best_k, best_n, out->p);
+    (void)home__model_basis(mp->space, best, o, basis);
+    projected_normal(mp, (const double (*)[8])basis, k_of[best], o, n_mat, rhs);
+    out->sigma_px = model_sigma(mp, (const double (*)[8])basis, k_of[best], n_mat, out->p);
     if (!isfinite(out->sigma_px)) return 0;
     /* a simpler model's error also holds its misfit: the RMS corner distance to the most
      * general determined estimate (a static scene's identity is off by the motion it ignores) */
     if (general > best) {
         double ha[8], hb[8];
-        if (to_h(mp->space, out->p, ha) && to_h(mp->space, general_p, hb)) {
+        if (to_h(mp->space, out->p, ha) && to_h(mp->space, p_of[general], hb)) {
             const double bias = corner_rms_distance(ha, hb, mp);
             out->sigma_px = sqrt(out->sigma_px * out->sigma_px + bias * bias);
         }

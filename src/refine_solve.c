@@ -18,6 +18,9 @@
  * the residual variance (two frames' noise) times this; taking each block's strongest
  * gradient raises it above 1 (3: the tuning set's calibration, docs/trust.md) */
 #define NOISE_GRADIENT_SHARE 3.0
+#define MODEL_FLOOR_PX 0.3   /* the model choice's floor (src/model.c): error of each corner
+                                the Fisher information does not see (dim frames of a few edges:
+                                homographies 1-2 px off at a predicted 0.2 px, docs/trust.md) */
 #define DETERMINED_STD_PX 0.25 /* home__refine_determined(): a direction of the translation is
                                   solved when its standard deviation (without the noise's
                                   apparent information) is at most this, full-size px at the
@@ -647,8 +650,9 @@ static int update_between(const double *hn, const double *hn2, double *dp)
 
 /* Model selection over the refinement's Fisher information (src/model.c): J^T W J over the
  * weighted residual variance is the information of the update dp at the estimate; the chain
- * rule through dp(h) (central differences) gives that of h's entries. h1 (pixels) becomes the
- * chosen model's estimate; sets result->model and sigma_px. */
+ * rule through dp(h) (central differences) gives that of h's entries. A homography must also
+ * stand out of MODEL_FLOOR_PX. h1 (pixels) becomes the chosen model's estimate; sets
+ * result->model and sigma_px. */
 static int choose_model(home__refine_solver *s, int max_model, double *h1, home_result *result)
 {
     home__model_problem mp;
@@ -685,6 +689,7 @@ static int choose_model(home__refine_solver *s, int max_model, double *h1, home_
     mp.scale = s->f;
     mp.cx = s->cx;
     mp.cy = s->cy;
+    mp.floor_px = MODEL_FLOOR_PX;
     if (!home__select_model(&mp, &choice)) return 0;
     memcpy(hn, choice.p, 8 * sizeof *hn);
     hn[8] = 1.0;
