@@ -237,7 +237,8 @@ static int invert8(double *a, double *inv)
 
 /* The information `info` with floor_px of independent error added to each corner coordinate:
  * in corner coordinates c = J p, F_c = J^-T F J^-1 becomes (F_c^-1 + floor^2 I)^-1 =
- * F_c (I + floor^2 F_c)^-1, then back, J^T F_c' J. 0 when J is singular. */
+ * F_c (I + floor^2 F_c)^-1, then back, J^T F_c' J. 0 when J is singular or I + floor^2 F_c
+ * not positive definite. */
 static int floored_information(const home__model_problem *mp, double *out)
 {
     double cj[8][8], a[64], jinv[64], fc[64], t[64], l[64];
@@ -325,13 +326,15 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
     enum { MODELS = HOME_MODEL_HOMOGRAPHY + 1 };
     double basis[8][8], o[8], n_mat[64], rhs[8], weigh[64];
     double p_of[MODELS][8], delta_of[MODELS], floored_of[MODELS];
-    int k_of[MODELS], model, i, j, best = -1, general = -1;
+    int k_of[MODELS], model, i, j, best = -1, general = -1, floored;
     double best_score = INFINITY;
 
     out->model = -1;
     out->sigma_px = INFINITY;
-    if (mp->floor_px > 0.0 && mp->space == HOME__SPACE_H && !floored_information(mp, weigh))
-        return 0;
+    /* the floor weighs only a homography against the simpler models (an information it cannot
+     * be added to leaves the plain choice) */
+    floored = mp->floor_px > 0.0 && mp->space == HOME__SPACE_H &&
+              mp->max_model == HOME_MODEL_HOMOGRAPHY && floored_information(mp, weigh);
     for (model = HOME_MODEL_IDENTITY; model <= mp->max_model; model++) {
         double q[8], diff[8], a_copy[64];
         const int k = home__model_basis(mp->space, model, o, basis);
@@ -348,8 +351,7 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
         for (i = 0; i < 8; i++) diff[i] = p_of[model][i] - mp->p[i];
         delta_of[model] = quadratic8(diff, mp->info);
         if (!isfinite(delta_of[model])) continue;
-        floored_of[model] = mp->floor_px > 0.0 && mp->space == HOME__SPACE_H
-                                ? quadratic8(diff, weigh) : delta_of[model];
+        floored_of[model] = floored ? quadratic8(diff, weigh) : delta_of[model];
         k_of[model] = k;
         general = model; /* the most general determined model so far */
         if (delta_of[model] + mp->penalty * k < best_score) {
@@ -361,7 +363,7 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
     /* a homography must also stand out of the corners' error floor: a translation, similarity
      * or affine takes its place when it scores lower with the floor (not the identity: a small
      * motion does not become none because of a floor) */
-    if (best == HOME_MODEL_HOMOGRAPHY && mp->floor_px > 0.0) {
+    if (best == HOME_MODEL_HOMOGRAPHY && floored) {
         double floored_best = mp->penalty * k_of[best];
         const int chosen = best;
         for (model = HOME_MODEL_TRANSLATION; model < HOME_MODEL_HOMOGRAPHY; model++)
