@@ -15,7 +15,8 @@
     X(deterministic_output) X(fails_cleanly) X(bad_inputs) X(kernels_radon) X(kernels_line_ends) X(kernels_resample) X(kernels_nearest) \
     X(kernels_smooth) X(kernels_box_down) X(kernels_extremum_candidates) X(refine_kernels_backends) \
     X(warp_backends_identical) X(warp_plane_end) X(backends_identical_output) X(fast_hough_matches_exact) \
-    X(static_scene_is_identity) X(shift_is_translation) X(model_cap) X(model_floor_weighs_perspective) X(capped_perspective_is_one_motion) X(sigma_calibrated) X(few_edges_never_wrong) \
+    X(static_scene_is_identity) X(shift_is_translation) X(model_cap) X(model_floor_weighs_perspective) \
+    X(capped_perspective_is_one_motion) X(sigma_calibrated) X(few_edges_never_wrong) \
     X(textured_mover_never_steers) X(static_fog_is_identity) X(raw_fog_never_moves) X(fence_never_aliased) \
     X(pegboard_never_aliased)
 

@@ -412,7 +412,7 @@ void test_theta_window_prior(void)
     CHECK(res.matches > 100);
 }
 
-/* Corners (px) of a normalised homography p (h8 = 1) on a w x h frame, pixel = scale u + centre. */
+/* Corners (px) of a normalised homography p (h8 = 1): pixel = scale u + (cx, cy). */
 static void model_corners(const double *p, double scale, double cx, double cy, double *xy)
 {
     int c;
@@ -479,7 +479,10 @@ void test_model_floor_weighs_perspective(void)
     CHECK(fabs(floored.p[6]) < 1e-12 && fabs(floored.p[7]) < 1e-12);
     model_corners(mp.p, mp.scale, mp.cx, mp.cy, corners_h);
     model_corners(floored.p, mp.scale, mp.cx, mp.cy, corners_affine);
-    for (i = 0; i < 8; i++) rms += (corners_h[i] - corners_affine[i]) * (corners_h[i] - corners_affine[i]);
+    for (i = 0; i < 8; i++) {
+        const double d = corners_h[i] - corners_affine[i];
+        rms += d * d;
+    }
     rms = sqrt(rms / 4.0);
     printf("    perspective left out: %.3f px RMS, sigma %.3f px\n", rms, floored.sigma_px);
     CHECK(rms > 0.2 && rms < 0.8);
