@@ -14,8 +14,8 @@
  * A fit's information sees independent noise, not errors its observations share (the photometric
  * refinement on the few edges of a dim frame: homographies 1-2 px off at a predicted 0.2 px,
  * their halves agreeing). With floor_px > 0 a homography chosen over the plain information must
- * also win with floor_px of error added to each corner coordinate, (F^-1 + J^-1 floor^2
- * J^-T)^-1 with J the corners' Jacobian; otherwise the best simpler model by that measure
+ * also win with floor_px of error added to each corner coordinate, (F^-1 + floor^2 (J^T
+ * J)^-1)^-1 with J the corners' Jacobian; otherwise the best simpler model by that measure
  * stands, and its predicted error holds the perspective it leaves out, as below.
  *
  * Spaces: the refinement's p are the homography's entries h0..h7 (h8 = 1) in normalised
@@ -198,88 +198,33 @@ static double model_sigma(const home__model_problem *mp, const double basis[8][8
     return sqrt(var / 4.0); /* RMS over the four corners of the 2-D error */
 }
 
-/* The inverse of the 8x8 matrix a (destroyed) by Gauss-Jordan with partial pivoting; 0 when
- * singular. */
-static int invert8(double *a, double *inv)
-{
-    int i, j, r, c;
-    for (i = 0; i < 64; i++) inv[i] = i % 9 == 0 ? 1.0 : 0.0;
-    for (c = 0; c < 8; c++) {
-        int pivot = c;
-        double d;
-        for (r = c + 1; r < 8; r++)
-            if (fabs(a[r * 8 + c]) > fabs(a[pivot * 8 + c])) pivot = r;
-        if (!(fabs(a[pivot * 8 + c]) > 1e-300)) return 0;
-        for (j = 0; j < 8; j++) {
-            double t = a[c * 8 + j];
-            a[c * 8 + j] = a[pivot * 8 + j];
-            a[pivot * 8 + j] = t;
-            t = inv[c * 8 + j];
-            inv[c * 8 + j] = inv[pivot * 8 + j];
-            inv[pivot * 8 + j] = t;
-        }
-        d = a[c * 8 + c];
-        for (j = 0; j < 8; j++) {
-            a[c * 8 + j] /= d;
-            inv[c * 8 + j] /= d;
-        }
-        for (r = 0; r < 8; r++) {
-            const double f = a[r * 8 + c];
-            if (r == c || f == 0.0) continue;
-            for (j = 0; j < 8; j++) {
-                a[r * 8 + j] -= f * a[c * 8 + j];
-                inv[r * 8 + j] -= f * inv[c * 8 + j];
-            }
-        }
-    }
-    return 1;
-}
-
 /* The information `info` with floor_px of independent error added to each corner coordinate:
- * in corner coordinates c = J p, F_c = J^-T F J^-1 becomes (F_c^-1 + floor^2 I)^-1 =
- * F_c (I + floor^2 F_c)^-1, then back, J^T F_c' J. 0 when J is singular or I + floor^2 F_c
- * not positive definite. */
+ * with J the corners' Jacobian and G = J^T J / floor^2 (the floor's information), (F^-1 +
+ * G^-1)^-1 = G (F + G)^-1 F. 0 when F + G is not positive definite. */
 static int floored_information(const home__model_problem *mp, double *out)
 {
-    double cj[8][8], a[64], jinv[64], fc[64], t[64], l[64];
-    const double f2 = mp->floor_px * mp->floor_px;
+    double cj[8][8], g[64], l[64];
+    const double w = 1.0 / (mp->floor_px * mp->floor_px);
     int i, j, k;
     corner_jacobian(mp->p, mp->scale, mp->cx, mp->cy, cj);
     for (i = 0; i < 8; i++)
-        for (j = 0; j < 8; j++) a[i * 8 + j] = cj[i][j];
-    if (!invert8(a, jinv)) return 0;
-    for (i = 0; i < 8; i++) /* t = F J^-1, fc = J^-T t */
         for (j = 0; j < 8; j++) {
             double v = 0.0;
-            for (k = 0; k < 8; k++) v += mp->info[i * 8 + k] * jinv[k * 8 + j];
-            t[i * 8 + j] = v;
+            for (k = 0; k < 8; k++) v += cj[k][i] * cj[k][j];
+            g[i * 8 + j] = v * w;
+            l[i * 8 + j] = g[i * 8 + j] + mp->info[i * 8 + j];
         }
-    for (i = 0; i < 8; i++)
-        for (j = 0; j < 8; j++) {
-            double v = 0.0;
-            for (k = 0; k < 8; k++) v += jinv[k * 8 + i] * t[k * 8 + j];
-            fc[i * 8 + j] = v;
-        }
-    for (i = 0; i < 64; i++) l[i] = f2 * 0.5 * (fc[i] + fc[(i % 8) * 8 + i / 8]) + (i % 9 == 0);
     if (!home__cholesky8(l)) return 0;
-    for (j = 0; j < 8; j++) { /* t = (I + floor^2 F_c)^-1 F_c, column by column: F_c' = t^T */
+    for (j = 0; j < 8; j++) { /* (F + G)^-1 F column by column, then G times it */
         double col[8];
-        for (i = 0; i < 8; i++) col[i] = fc[i * 8 + j];
+        for (i = 0; i < 8; i++) col[i] = mp->info[i * 8 + j];
         home__cholesky_solve8(l, col);
-        for (i = 0; i < 8; i++) t[i * 8 + j] = col[i];
-    }
-    for (i = 0; i < 8; i++) /* fc = F_c' J, out = J^T fc */
-        for (j = 0; j < 8; j++) {
+        for (i = 0; i < 8; i++) {
             double v = 0.0;
-            for (k = 0; k < 8; k++) v += t[k * 8 + i] * cj[k][j];
-            fc[i * 8 + j] = v;
-        }
-    for (i = 0; i < 8; i++)
-        for (j = 0; j < 8; j++) {
-            double v = 0.0;
-            for (k = 0; k < 8; k++) v += cj[k][i] * fc[k * 8 + j];
+            for (k = 0; k < 8; k++) v += g[i * 8 + k] * col[k];
             out[i * 8 + j] = v;
         }
+    }
     return 1;
 }
 
