@@ -93,6 +93,8 @@ typedef struct home__refine_state {
     double score[3];                  /* ... observed, expected, evidence */
     double unexplained;               /* the share of regions its ok answer leaves unexplained
                                          (0: not measured: the identity, or within its sigma) */
+    int stood_in;                     /* the last home__refine_run()'s answer is a similarity
+                                         standing in for an undetermined homography */
     uint32_t dense_ids[2];            /* the frames of the last dense alignment (0: none), */
     int dense_model;                  /* ... its cfg.max_model, */
     int dense_found;                  /* ... whether it found a motion, */

@@ -107,7 +107,7 @@ static int same_optimum(home_context *ctx, int slot, const double *start, int pa
     int k;
     for (k = 0; k < 9; k++) mid[k] = 0.5 * (start[k] + refined->H[k]);
     check.refined = 0; /* set again only where this refinement converges */
-    home__refine_run(ctx, slot, mid, patient, &check);
+    home__refine_run(ctx, slot, mid, patient, 1, &check);
     if (tolerance < SAME_OPTIMUM_FLOOR_PX) tolerance = SAME_OPTIMUM_FLOOR_PX;
     return check.refined && corner_distance(ctx, check.H, refined->H) <= tolerance;
 }
@@ -316,7 +316,7 @@ static int points_agree(home_context *ctx, int slot, const home_result *dense)
     home_result check = *dense;
     double tolerance;
     check.refined = 0;
-    home__refine_run(ctx, slot, dense->H, 0, &check);
+    home__refine_run(ctx, slot, dense->H, 0, 0, &check);
     if (!check.refined) return 1;
     tolerance = 3.0 * (check.sigma_px > dense->sigma_px ? check.sigma_px : dense->sigma_px);
     return corner_distance(ctx, check.H, dense->H) <= tolerance;
@@ -328,7 +328,8 @@ static int points_agree(home_context *ctx, int slot, const home_result *dense)
  * within the convergence tolerance. Beside an estimate HOME cannot vouch for, a homography
  * fitted to a few dim edges may stop in one of several optima, or anywhere along a flat
  * valley, each predicting a small error (docs/trust.md, session 23). */
-static double probe_spread(home_context *ctx, int slot, const home_result *refined)
+static double probe_spread(home_context *ctx, int slot, const home_result *refined,
+                           int stand_in)
 {
     static const double shifts[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
     double spread = 0.0;
@@ -340,7 +341,7 @@ static double probe_spread(home_context *ctx, int slot, const home_result *refin
         start[2] += PROBE_PX * shifts[k][0];
         start[5] += PROBE_PX * shifts[k][1];
         probe.refined = 0;
-        home__refine_run(ctx, slot, start, 0, &probe);
+        home__refine_run(ctx, slot, start, 0, stand_in, &probe);
         if (!probe.refined || !vouches(ctx, &probe, 0)) continue;
         d = corner_distance(ctx, probe.H, refined->H);
         if (d > spread) spread = d;
@@ -353,7 +354,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
 {
     home__refine_state *st = &ctx->refine;
     home_result trial, confirmed;
-    int slot, agrees, has_estimate, patient;
+    int slot, agrees, has_estimate, patient, stood_in;
     double t0 = home__now(ctx), radius, d, share, clear_share, apart;
     result->refined = 0;
     result->refine_status = HOME_REFINE_OFF;
@@ -375,12 +376,19 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
     /* without an estimate of HOME's, direct alignment from the identity (small motion: dim,
      * faint or textureless frames give too few lines but may hold enough gradient) */
     apart = home__refine_run(ctx, slot, has_estimate ? result->H : home__refine_identity, patient,
-                             &trial);
+                             1, &trial);
+    stood_in = ctx->refine.stood_in;
     if (!has_estimate) {
         /* a local method vouches only within its reach: the identity is a start whose
          * uncertainty is the trust floor; and not for a homography, whose perspective nothing
          * but the photometric fit then fixes (a few dim edges: 11 of the tuning set's 12 such
          * answers were 1.9-9.4 px off at a predicted 0.2-0.4 px, docs/trust.md session 23) */
+        if (trial.refined && stood_in) {
+            /* a similarity standing in: its error is at least the spread of the optima other
+             * starts reach (vouches() then holds it to the bound) */
+            const double spread = probe_spread(ctx, slot, &trial, 1);
+            if (spread > trial.sigma_px) trial.sigma_px = spread;
+        }
         if (trial.refined && vouches(ctx, &trial, 1) && trial.model != HOME_MODEL_HOMOGRAPHY &&
             corner_distance(ctx, trial.H, home__refine_identity) <=
                 ctx->cfg.refine_trust_px * ctx->hough_scale) {
@@ -414,10 +422,10 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         } else if (agrees ? result->ok || vouches(ctx, &trial, 0)
                           : vouches(ctx, &trial, 1) &&
                                 same_optimum(ctx, slot, result->H, patient, &trial)) {
-            /* a homography on the photometric evidence alone: its error is at least the
-             * spread of the optima other starts reach */
-            if (!result->ok && trial.model == HOME_MODEL_HOMOGRAPHY) {
-                const double spread = probe_spread(ctx, slot, &trial);
+            /* a homography on the photometric evidence alone, or a similarity standing in for
+             * one: its error is at least the spread of the optima other starts reach */
+            if (!result->ok && (trial.model == HOME_MODEL_HOMOGRAPHY || stood_in)) {
+                const double spread = probe_spread(ctx, slot, &trial, stood_in);
                 if (spread > trial.sigma_px) trial.sigma_px = spread;
             }
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;

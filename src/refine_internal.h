@@ -41,6 +41,8 @@ typedef struct home__refine_solver {
     double resid_var;                   /* weighted residual variance of the last iteration
                                            (set once the finest level converged) */
     double split_px;                    /* split-half disagreement of the last finest step */
+    double jtr[8];                      /* J^T W r of the last iteration (all 8 parameters) */
+    double step[8];                     /* ... and the update it took (within the model) */
     int finest;                         /* level the estimate ends at */
     int k;                              /* parameters of the model fitted (8: a homography) */
     double basis[8][8];                 /* the update's subspace dp = B q when k < 8 */
@@ -124,9 +126,11 @@ double home__refine_max_corner_distance(double cx, double cy, const double *h1,
  * templates approach the optimum slowly). */
 /* Returns, when it converged but the optimum is too uncertain to use (ILL_CONDITIONED), how far
  * the optimum lies from h0 in units of both estimates' predicted errors (result->sigma_px on
- * entry is h0's); else 0. */
+ * entry is h0's); else 0. may_stand_in: where the homography is not determined and HOME's
+ * estimate (result->ok on entry) is not ok, a similarity may stand in for it (sets
+ * ctx->refine.stood_in); probes of a homography's own optima pass 0. */
 double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
-                        home_result *result);
+                        int may_stand_in, home_result *result);
 /* The same (not patient) as a homography, whatever cfg.max_model caps the answer to: the
  * motion the frame's pixels give where a capped model misfits them. */
 void home__refine_run_homography(home_context *ctx, int slot, const double *h0,

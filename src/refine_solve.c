@@ -25,6 +25,14 @@
                                   solved when its standard deviation (without the noise's
                                   apparent information) is at most this, full-size px at the
                                   finest level (twice per coarser level) */
+#define STAND_IN_MAX_MISFIT_PX 0.5 /* home__refine_run(): a similarity standing in for an
+                                     undetermined homography leaves out at most this much
+                                     perspective, */
+#define STAND_IN_MAX_SIGMA_PX 0.15 /* ... its own predicted error is at most this, */
+#define STAND_IN_MIN_SIGNAL 0.8 /* ... and at least this share of its translation's information is
+                                   the frames' (not the template's gradient noise): only sharp
+                                   edges pin a similarity; faint content, dim or shaded, leaves
+                                   it at a biased optimum (docs/trust.md, session 33) */
 #define SLOW_ITERATIONS 4    /* a finest level still shrinking its steps may take this many
                                 times the iteration cap */
 #define SIGNAL_SHARE_MIN 0.05 /* ... the information kept then, at least this share */
@@ -404,6 +412,7 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
         if (shaded) eliminate_shading(col, kk, gk, a, g);
     }
     memcpy(s->jtj, a, sizeof a);
+    memcpy(s->jtr, g, sizeof s->jtr);
     if (level == s->finest) {
         /* split-half check: the steps of the even and the odd lanes (interleaved halves of the
          * points) from the same estimate agree when the points carry signal and scatter when
@@ -427,6 +436,7 @@ static int iterate(home__refine_solver *s, int level, double *step_px)
     }
     if (!model_solve(s, a, g)) return 0;
     for (p = 0; p < 8; p++) dp[p] = g[p];
+    memcpy(s->step, dp, sizeof s->step);
     *step_px = corner_step_px(s, dp);
     if (shaded) {
         double dk = gk;
@@ -562,6 +572,42 @@ static double corner_std_px(const home__refine_solver *s)
         }
         var *= s->resid_var * s->f * s->f;
         if (sqrt(var) > worst) worst = sqrt(var);
+    }
+    return worst;
+}
+
+/* How far a homography's optimum lies from the similarity standing in for it, px at the worst
+ * corner: the last linearisation's full Gauss-Newton step (all 8 parameters) less the step the
+ * similarity took. A prior of MODEL_FLOOR_PX per corner holds the directions the frames do not
+ * determine at the similarity; those they do determine show the perspective the similarity
+ * leaves out (a still pair's, far larger than a consecutive frame's). */
+static double stand_in_misfit_px(const home__refine_solver *s)
+{
+    const double hu = s->cx / s->f, hv = s->cy / s->f;
+    const double prior = s->resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE * s->f * s->f /
+                         (MODEL_FLOOR_PX * MODEL_FLOOR_PX);
+    double a[64], d[8], jc[4][2][8], worst = 0.0;
+    int k, axis, i, j;
+    for (k = 0; k < 4; k++) {
+        const double u = (k & 1) ? hu : -hu, v = (k & 2) ? hv : -hv;
+        const double row[2][8] = {{u, v, 1, 0, 0, 0, -u * u, -u * v},
+                                  {0, 0, 0, u, v, 1, -u * v, -v * v}};
+        memcpy(jc[k], row, sizeof row);
+    }
+    memcpy(a, s->jtj, sizeof a);
+    memcpy(d, s->jtr, sizeof d);
+    for (k = 0; k < 4; k++)
+        for (axis = 0; axis < 2; axis++)
+            for (i = 0; i < 8; i++)
+                for (j = 0; j < 8; j++) a[i * 8 + j] += prior * jc[k][axis][i] * jc[k][axis][j];
+    if (!home__solve_spd8(a, d)) return INFINITY;
+    for (i = 0; i < 8; i++) d[i] -= s->step[i];
+    for (k = 0; k < 4; k++) {
+        double e[2] = {0.0, 0.0};
+        for (axis = 0; axis < 2; axis++)
+            for (i = 0; i < 8; i++) e[axis] += jc[k][axis][i] * d[i];
+        e[0] = s->f * sqrt(e[0] * e[0] + e[1] * e[1]);
+        if (!(e[0] <= worst)) worst = e[0];
     }
     return worst;
 }
@@ -829,15 +875,17 @@ static int run_level(home__refine_solver *s, int level, int max_iterations, int 
 
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
  * without the points of the excluded regions (NULL: none), on a probe's leash (NULL: none),
- * with a lens falloff fitted beside the motion when shading is set. Writes the refined H and
- * fills the refine fields of result. */
-static double refine_run(home_context *ctx, int slot, const double *h0,
-                         const unsigned char *excluded, const probe_leash *leash, int patient,
-                         int shading, int max_model, home_result *result)
+ * with a lens falloff fitted beside the motion when shading is set; stand_in: a similarity
+ * standing in for an undetermined homography, refused outside the STAND_IN_ limits, its sigma
+ * holding the perspective it leaves out. Writes the refined H and fills the refine fields of
+ * result. */
+static double refine_model(home_context *ctx, int slot, const double *h0,
+                           const unsigned char *excluded, const probe_leash *leash, int patient,
+                           int shading, int max_model, int stand_in, home_result *result)
 {
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
-    double hn0[9], h1[9], e0, e1, zncc0, zncc1, refined_std;
+    double hn0[9], h1[9], e0, e1, zncc0, zncc1, refined_std, misfit = 0.0, signal;
     int level, k, converged = 0, iterations = 0;
     const double max_std =
         MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
@@ -851,6 +899,13 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
     if (max_model < HOME_MODEL_HOMOGRAPHY) {
         double o[8];
         s.k = home__model_basis(HOME__SPACE_H, max_model, o, s.basis);
+    }
+    if (stand_in && s.finest != st->finest_level) {
+        /* faint texture (too few points at the level the estimate should end at): nothing
+         * there vouches for the similarity (fog, dim gradients, dim few edges: 86 of the tuning
+         * set's 263 such stand-ins were more than 2 px off, 71 more beyond 3 sigma) */
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return 0.0;
     }
     home__refine_to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
@@ -875,7 +930,12 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
     if (!converged) { result->refine_status = HOME_REFINE_NOT_CONVERGED; return 0.0; }
     to_pixels(&s, s.hn, h1);
     s.resid_var = residual_variance(&s);
+    if (stand_in) misfit = stand_in_misfit_px(&s);
+    signal = s.jtj[2 * 8 + 2] + s.jtj[5 * 8 + 5];
     remove_noise_information(&s);
+    /* the share of the translation's information that is the frames', not the template's
+     * gradient noise */
+    signal = signal > 0.0 ? (s.jtj[2 * 8 + 2] + s.jtj[5 * 8 + 5]) / signal : 0.0;
     if (s.signal_share < 1.0)
         for (k = 0; k < 64; k++) s.jtj[k] *= s.signal_share;
     refined_std = corner_std_px(&s);
@@ -908,14 +968,45 @@ static double refine_run(home_context *ctx, int slot, const double *h0,
         result->refine_status = HOME_REFINE_NOT_LOWER;
         return 0.0;
     }
-    if (!choose_model(&s, max_model, h1, result)) {
+    if (!choose_model(&s, max_model, h1, result) ||
+        (stand_in && !(misfit <= STAND_IN_MAX_MISFIT_PX &&
+                       result->sigma_px <= STAND_IN_MAX_SIGMA_PX && signal >= STAND_IN_MIN_SIGNAL))) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0.0;
     }
+    /* a stand-in's error holds the perspective it leaves out */
+    result->sigma_px = sqrt(result->sigma_px * result->sigma_px + misfit * misfit);
     memcpy(result->H, h1, sizeof h1);
     result->refined = 1;
     result->refine_status = HOME_REFINE_ACCEPTED;
     return 0.0;
+}
+
+/* The refinement of the most general model cfg.max_model allows. Where that is a homography the
+ * frames do not determine (a few long edges: ill conditioned, or sliding without converging)
+ * and HOME's estimate is not ok (an ok line fit's homography stands), a similarity stands in
+ * for it from the same start, if the perspective it leaves out is small
+ * (stand_in_misfit_px()). */
+double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
+                        int may_stand_in, home_result *result)
+{
+    const home_result start = *result;
+    const double apart = refine_model(ctx, slot, h0, NULL, NULL, patient, 0,
+                                      ctx->cfg.max_model, 0, result);
+    ctx->refine.stood_in = 0;
+    if (may_stand_in && ctx->cfg.max_model == HOME_MODEL_HOMOGRAPHY && !start.ok &&
+        (result->refine_status == HOME_REFINE_ILL_CONDITIONED ||
+         result->refine_status == HOME_REFINE_NOT_CONVERGED)) {
+        home_result capped = start;
+        capped.refined = 0;
+        refine_model(ctx, slot, h0, NULL, NULL, patient, 0, HOME_MODEL_SIMILARITY, 1, &capped);
+        if (capped.refined) {
+            *result = capped;
+            ctx->refine.stood_in = 1;
+            return 0.0;
+        }
+    }
+    return apart;
 }
 
 /* Eigen-decomposition of the symmetric n x n matrix a (row stride 8, destroyed: its diagonal
@@ -1043,27 +1134,21 @@ int home__refine_determined(home_context *ctx, int slot, double *h, double *sigm
     return 1;
 }
 
-double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
-                        home_result *result)
-{
-    return refine_run(ctx, slot, h0, NULL, NULL, patient, 0, ctx->cfg.max_model, result);
-}
-
 void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
                                  home_result *result)
 {
-    refine_run(ctx, slot, h0, NULL, NULL, 0, 0, HOME_MODEL_HOMOGRAPHY, result);
+    refine_model(ctx, slot, h0, NULL, NULL, 0, 0, HOME_MODEL_HOMOGRAPHY, 0, result);
 }
 
 void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, home_result *result)
 {
-    refine_run(ctx, slot, h0, NULL, NULL, 1, 1, ctx->cfg.max_model, result);
+    refine_model(ctx, slot, h0, NULL, NULL, 1, 1, ctx->cfg.max_model, 0, result);
 }
 
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,
                                 const unsigned char *excluded, home_result *result)
 {
-    return refine_run(ctx, slot, h0, excluded, NULL, 0, 0, ctx->cfg.max_model, result);
+    return refine_model(ctx, slot, h0, excluded, NULL, 0, 0, ctx->cfg.max_model, 0, result);
 }
 
 void home__refine_probe(home_context *ctx, int slot, const double *h0, const double *back,
@@ -1072,5 +1157,5 @@ void home__refine_probe(home_context *ctx, int slot, const double *h0, const dou
     probe_leash leash;
     leash.back = back;
     leash.radius = radius;
-    refine_run(ctx, slot, h0, NULL, &leash, 0, 0, ctx->cfg.max_model, result);
+    refine_model(ctx, slot, h0, NULL, &leash, 0, 0, ctx->cfg.max_model, 0, result);
 }
