@@ -28,7 +28,7 @@
 #define STAND_IN_MAX_MISFIT_PX 0.5 /* home__refine_run(): a similarity standing in for an
                                      undetermined homography leaves out at most this much
                                      perspective, */
-#define STAND_IN_MAX_SIGMA_PX 0.2 /* ... its own predicted error is at most this, */
+#define STAND_IN_MAX_SIGMA_PX 0.15 /* ... its own predicted error is at most this, */
 #define STAND_IN_MIN_SIGNAL 0.8 /* ... and at least this share of its translation's information is
                                    the frames' (not the template's gradient noise): only sharp
                                    edges pin a similarity; faint content, dim or shaded, leaves
@@ -899,6 +899,13 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     if (max_model < HOME_MODEL_HOMOGRAPHY) {
         double o[8];
         s.k = home__model_basis(HOME__SPACE_H, max_model, o, s.basis);
+    }
+    if (stand_in && s.finest != st->finest_level) {
+        /* faint texture (too few points at the level the estimate should end at): nothing
+         * there vouches for the similarity (fog, dim gradients, dim few edges: 86 of the tuning
+         * set's 263 such stand-ins were more than 2 px off, 71 more beyond 3 sigma) */
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return 0.0;
     }
     home__refine_to_normalised(&s, h0, hn0);
     memcpy(s.hn, hn0, sizeof hn0);
