@@ -900,12 +900,6 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
         double o[8];
         s.k = home__model_basis(HOME__SPACE_H, max_model, o, s.basis);
     }
-    /* a few sharp edges at half size (the video preset's finest level) fill fewer points than
-     * FINEST_MIN_POINTS asks of faint texture; a quarter of the level's capacity lets a
-     * stand-in end there (fog and dim gradients fill less, the signal share refuses the rest) */
-    if (stand_in && s.finest != st->finest_level &&
-        s.tpl[st->finest_level].n >= s.tpl[st->finest_level].capacity / 4)
-        s.finest = st->finest_level;
     if (stand_in && s.finest != st->finest_level) {
         /* faint texture (too few points at the level the estimate should end at): nothing
          * there vouches for the similarity (fog, dim gradients, dim few edges: 86 of the tuning
