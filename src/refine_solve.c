@@ -586,7 +586,7 @@ static double stand_in_misfit_px(const home__refine_solver *s)
     const double hu = s->cx / s->f, hv = s->cy / s->f;
     const double prior = s->resid_var * REFINE_SIGMA_SCALE * REFINE_SIGMA_SCALE * s->f * s->f /
                          (MODEL_FLOOR_PX * MODEL_FLOOR_PX);
-    double a[64], d[8], jc[4][2][8], worst = 0.0;
+    double a[64], d[8], jc[4][2][8];
     int k, axis, i, j;
     for (k = 0; k < 4; k++) {
         const double u = (k & 1) ? hu : -hu, v = (k & 2) ? hv : -hv;
@@ -602,14 +602,7 @@ static double stand_in_misfit_px(const home__refine_solver *s)
                 for (j = 0; j < 8; j++) a[i * 8 + j] += prior * jc[k][axis][i] * jc[k][axis][j];
     if (!home__solve_spd8(a, d)) return INFINITY;
     for (i = 0; i < 8; i++) d[i] -= s->step[i];
-    for (k = 0; k < 4; k++) {
-        double e[2] = {0.0, 0.0};
-        for (axis = 0; axis < 2; axis++)
-            for (i = 0; i < 8; i++) e[axis] += jc[k][axis][i] * d[i];
-        e[0] = s->f * sqrt(e[0] * e[0] + e[1] * e[1]);
-        if (!(e[0] <= worst)) worst = e[0];
-    }
-    return worst;
+    return corner_step_px(s, d);
 }
 
 /* Robust photometric error of the finest-level B samples img_b over the points other_b (the
