@@ -482,6 +482,8 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         const double d_identity = corner_distance(ctx, trial.H, home__refine_identity);
         const int within_sigma =
             isfinite(trial.sigma_px) && d_identity <= IDENTITY_SIGMAS * trial.sigma_px;
+        const int stands_in = stood_in && trial.refined && trial.model != HOME_MODEL_HOMOGRAPHY &&
+                              trial.refine_status != HOME_REFINE_DENSE;
         int against = 0, identity_wins;
         unsigned char still_regions[REGIONS_X * REGIONS_Y] = {0};
         double own_motion;
@@ -491,10 +493,14 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
                                                 still_regions);
         /* the plain regions, when their pixels show the identity, outweigh the textured regions
          * that prefer the motion (the background wins by area: a flat occluder in front of
-         * the lens moves with the camera and covers less) */
-        identity_wins = within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
-                        (home__refine_plain_regions(ctx, slot) > against &&
-                         home__refine_plain_background(ctx, slot, trial.H) >= PLAIN_Z);
+         * the lens moves with the camera and covers less). Against a similarity standing in,
+         * where a few long edges are all the frame's texture, the lens falloff is fitted
+         * first: it stays with the sensor, so on plain pixels it prefers the identity whatever
+         * the camera did (docs/trust.md, session 34) */
+        identity_wins =
+            within_sigma || share >= STATIC_SHARE || clear_share >= STATIC_SHARE ||
+            (home__refine_plain_regions(ctx, slot) > against &&
+             home__refine_plain_background(ctx, slot, trial.H, stands_in) >= PLAIN_Z);
         if (identity_wins && !within_sigma && trial.refine_status == HOME_REFINE_DENSE) {
             /* the dense alignment's motion is what all pixels, the plain ones included, say;
              * regions that prefer the identity contradict it rather than refute it */

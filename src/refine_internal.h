@@ -172,8 +172,11 @@ int home__refine_plain_regions(const home_context *ctx, int slot);
  * the sum of the differences of the two robust costs over its own spread (a z score; positive:
  * the identity is better; 0 with too few plain regions or pixels). Their few faint
  * points cannot decide a region's vote, but all their pixels together can: a horizon in fog,
- * the blocks an encoder left unchanged. */
-double home__refine_plain_background(home_context *ctx, int slot, const double *h);
+ * the blocks an encoder left unchanged. fit_falloff: h's side also fits a lens falloff fixed
+ * to the sensor (s = 1 - kappa rho^2, rho^2 = 1 at the corners), which always prefers the
+ * identity on plain pixels whatever the camera did. */
+double home__refine_plain_background(home_context *ctx, int slot, const double *h,
+                                     int fit_falloff);
 
 /* refine_background.c: the score test of h (pixels, A -> B) on the fine backgrounds a and b
  * (background16 images: refine.background_w x background_h) at the pixels away from texture,

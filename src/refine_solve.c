@@ -33,6 +33,10 @@
                                    the frames' (not the template's gradient noise): only sharp
                                    edges pin a similarity; faint content, dim or shaded, leaves
                                    it at a biased optimum (docs/trust.md, session 33) */
+#define SPARSE_END_SIGMA 1.6 /* a stand-in ending at a level with fewer than FINEST_MIN_POINTS
+                                points predicts its error times this (tuning frames: its errors
+                                were 0.8 of the predicted in the median against 0.5 for the
+                                rest, one scene biased 0.3 px along two parallel edges) */
 #define SLOW_ITERATIONS 4    /* a finest level still shrinking its steps may take this many
                                 times the iteration cap */
 #define SIGNAL_SHARE_MIN 0.05 /* ... the information kept then, at least this share */
@@ -879,7 +883,7 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     const home__refine_state *st = &ctx->refine;
     home__refine_solver s;
     double hn0[9], h1[9], e0, e1, zncc0, zncc1, refined_std, misfit = 0.0, signal;
-    int level, k, converged = 0, iterations = 0;
+    int level, k, converged = 0, iterations = 0, sparse_end = 0;
     const double max_std =
         MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
 
@@ -892,6 +896,15 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     if (max_model < HOME_MODEL_HOMOGRAPHY) {
         double o[8];
         s.k = home__model_basis(HOME__SPACE_H, max_model, o, s.basis);
+    }
+    /* a few sharp edges at half size (the video preset's finest level) fill fewer points than
+     * FINEST_MIN_POINTS asks of faint texture; a quarter of the level's capacity lets a
+     * stand-in end there (fog and dim gradients fill less, the signal share refuses the rest),
+     * with a larger predicted error */
+    if (stand_in && s.finest != st->finest_level &&
+        s.tpl[st->finest_level].n >= s.tpl[st->finest_level].capacity / 4) {
+        s.finest = st->finest_level;
+        sparse_end = 1;
     }
     if (stand_in && s.finest != st->finest_level) {
         /* faint texture (too few points at the level the estimate should end at): nothing
@@ -969,6 +982,7 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     }
     /* a stand-in's error holds the perspective it leaves out */
     result->sigma_px = sqrt(result->sigma_px * result->sigma_px + misfit * misfit);
+    if (sparse_end) result->sigma_px *= SPARSE_END_SIGMA;
     memcpy(result->H, h1, sizeof h1);
     result->refined = 1;
     result->refine_status = HOME_REFINE_ACCEPTED;

@@ -22,6 +22,8 @@
 #define UNEXPLAINED_COST 3.0     /* a region the motion leaves unexplained: its cost over this
                                     many times the median region's, */
 #define UNEXPLAINED_IDENTITY 1.5 /* ... and the identity's at most this many times the motion's */
+#define PLAIN_KAPPA_MAX 0.8 /* the falloff the plain test fits for a motion: at most a darkening
+                               of four fifths at the corners */
 #define PLAIN_HIST_BINS 256  /* the identity's residual histogram: 32 grey levels *
                                 8 bins, the rest in one */
 
@@ -312,6 +314,70 @@ void home__refine_background_matrix(const home__refine_state *st, const double *
                 m[3 * i + j] += to_level[3 * i + k] * t[3 * k + j];
 }
 
+/* rho^2 of background pixel (x, y): 0 at the centre, 1 at the corners */
+static double rho2(double x, double y, int w, int h)
+{
+    const double cx = 0.5 * (w - 1), cy = 0.5 * (h - 1);
+    return ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (cx * cx + cy * cy);
+}
+
+/* rho^2 at pixel (x, y) and at its image under m */
+static void rho2_pair(const double *m, int x, int y, int w, int h, double *at_x, double *at_hx)
+{
+    const double den = m[6] * x + m[7] * y + m[8];
+    *at_x = rho2(x, y, w, h);
+    *at_hx = rho2((m[0] * x + m[1] * y + m[2]) / den, (m[3] * x + m[4] * y + m[5]) / den, w, h);
+}
+
+/* s(x) / s(h(x)) for a lens falloff s = 1 - kappa rho^2 fixed to the sensor: what frame B's
+ * sample at h(x) is multiplied by to compare with A at x (1 where kappa is 0). */
+static double falloff_ratio(const double *m, int x, int y, int w, int h, double kappa)
+{
+    double ra, rb;
+    if (kappa == 0.0) return 1.0;
+    rho2_pair(m, x, y, w, h, &ra, &rb);
+    return (1.0 - kappa * ra) / (1.0 - kappa * rb);
+}
+
+/* The falloff that explains A against B under m over the sampled plain pixels: least squares
+ * of A on B's sample, 1, and B's sample times the change of rho^2 under m (kappa over the gain),
+ * kappa within [0, PLAIN_KAPPA_MAX]; h's gain and bias are refitted with it. */
+static double plain_falloff(const home__refine_state *st, const double *m, const uint8_t *a,
+                            double n, double *gain, double *bias)
+{
+    const int w = st->background_w, h = st->background_h;
+    double nrm[64] = {0}, rhs[8] = {0}, kappa, sv = 0.0, svv = 0.0, svt = 0.0, sa = 0.0;
+    int i, j, l;
+    for (i = 0; i < w * h; i++) {
+        double f[3], ra, rb;
+        if (st->sampled[i] < 0) continue;
+        rho2_pair(m, i % w, i / w, w, h, &ra, &rb);
+        f[0] = st->sampled[i] / 16.0;
+        f[1] = 1.0;
+        f[2] = f[0] * (rb - ra); /* d(s(x) / s(h(x))) / d kappa at kappa = 0 */
+        for (j = 0; j < 3; j++) {
+            rhs[j] += f[j] * a[i];
+            for (l = 0; l < 3; l++) nrm[j * 8 + l] += f[j] * f[l];
+        }
+    }
+    if (!home__solve_spd(nrm, rhs, 3) || !(rhs[0] != 0.0)) return 0.0;
+    kappa = rhs[2] / rhs[0];
+    if (!(kappa > 0.0)) return 0.0;
+    if (kappa > PLAIN_KAPPA_MAX) kappa = PLAIN_KAPPA_MAX;
+    for (i = 0; i < w * h; i++) {
+        double v;
+        if (st->sampled[i] < 0) continue;
+        v = st->sampled[i] / 16.0 * falloff_ratio(m, i % w, i / w, w, h, kappa);
+        sv += v;
+        svv += v * v;
+        svt += v * a[i];
+        sa += a[i];
+    }
+    *gain = svv - sv * sv / n > 1e-9 * n ? (svt - sv * sa / n) / (svv - sv * sv / n) : 1.0;
+    *bias = (sa - *gain * sv) / n;
+    return kappa;
+}
+
 int home__refine_plain_regions(const home_context *ctx, int slot)
 {
     int r, n = 0;
@@ -319,14 +385,15 @@ int home__refine_plain_regions(const home_context *ctx, int slot)
     return n;
 }
 
-double home__refine_plain_background(home_context *ctx, int slot, const double *h)
+double home__refine_plain_background(home_context *ctx, int slot, const double *h,
+                                    int fit_falloff)
 {
     const home__refine_state *st = &ctx->refine;
     const int w = st->background_w, hh = st->background_h;
     /* frame B is the one stored last */
     const uint8_t *a = st->background[slot], *b = st->background[st->next_slot ^ 1];
     plain_sums acc;
-    double m[9], spread, sigma, c;
+    double m[9], spread, sigma, c, kappa;
     int e, i, half, cum;
     if (home__refine_plain_regions(ctx, slot) < PLAIN_MIN_PIXELS || w < 2 || hh < 2) return 0.0;
     home__refine_background_matrix(st, h, m);
@@ -341,6 +408,7 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
         acc.gain[e] = var_v > 1e-9 * acc.n ? cov / var_v : 1.0;
         acc.bias[e] = (acc.t - acc.gain[e] * acc.v[e]) / acc.n;
     }
+    kappa = fit_falloff ? plain_falloff(st, m, a, acc.n, &acc.gain[0], &acc.bias[0]) : 0.0;
     /* one scale for both: the identity's robust residual scale, not below the camera floor */
     for (i = 0; i < w * hh; i++) {
         double r;
@@ -356,7 +424,10 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
     for (i = 0; i < w * hh; i++) {
         double d;
         if (st->sampled[i] < 0) continue;
-        d = robust_cost(acc.gain[0] * (st->sampled[i] / 16.0) + acc.bias[0] - a[i], c) -
+        d = robust_cost(acc.gain[0] * (st->sampled[i] / 16.0) *
+                                falloff_ratio(m, i % w, i / w, w, hh, kappa) +
+                            acc.bias[0] - a[i],
+                        c) -
             robust_cost(acc.gain[1] * b[i] + acc.bias[1] - a[i], c);
         acc.d += d;
         acc.d2 += d * d;

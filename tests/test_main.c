@@ -17,7 +17,7 @@
     X(warp_backends_identical) X(warp_plane_end) X(backends_identical_output) X(fast_hough_matches_exact) \
     X(static_scene_is_identity) X(shift_is_translation) X(model_cap) X(model_floor_weighs_perspective) \
     X(capped_perspective_is_one_motion) X(sigma_calibrated) X(few_edges_never_wrong) \
-    X(few_edges_similarity_stands_in) \
+    X(few_edges_similarity_stands_in) X(few_edges_half_size_stand_ins) \
     X(textured_mover_never_steers) X(static_fog_is_identity) X(raw_fog_never_moves) X(fence_never_aliased) \
     X(pegboard_never_aliased)
 
