@@ -203,7 +203,7 @@ static int cap_misfit_only(home_context *ctx, int slot, const home_result *trial
  * when that refinement is accepted: refined without the falloff, those bend to it (tuning set,
  * where a falloff merely did not refute them: answers 0.8-1.5 px off at a predicted
  * 0.25-0.35 px; a few-edges pair 5.4 px off at 0.56 px). */
-static int background_refutes(home_context *ctx, int slot, home_result *trial,
+static int background_refutes(home_context *ctx, int slot, home_result *trial, int stands_in,
                               double *own_motion)
 {
     home__refine_state *st = &ctx->refine;
@@ -216,13 +216,20 @@ static int background_refutes(home_context *ctx, int slot, home_result *trial,
     memcpy(st->score, stats, sizeof st->score);
     *own_motion = stats[3];
     if (!st->scored || !home__refine_score_refutes(stats[0], stats[1], stats[2])) return 0;
-    if (!(shaded[1] >= BACKGROUND_EVIDENCE && shaded[2] >= BACKGROUND_EVIDENCE &&
-          shaded[0] >= shaded[1] / 3.0))
-        return 1;
-    /* the falloff is in the frames: the motion refined again with it */
     fit = *trial;
-    home__refine_run_shaded(ctx, slot, trial->H, &fit);
-    if (!similarity && fit.refine_status != HOME_REFINE_ACCEPTED) return 1;
+    if (!(shaded[1] >= BACKGROUND_EVIDENCE && shaded[2] >= BACKGROUND_EVIDENCE &&
+          shaded[0] >= shaded[1] / 3.0)) {
+        /* a similarity standing in for a few long edges over a plain background that could not
+         * show the motion once the falloff is out: nothing there refutes it; it stands if it
+         * stands in again with the falloff fitted */
+        if (!(stands_in && shaded[1] < BACKGROUND_EVIDENCE)) return 1;
+        home__refine_run_shaded(ctx, slot, trial->H, HOME_MODEL_SIMILARITY, 1, &fit);
+        if (fit.refine_status != HOME_REFINE_ACCEPTED) return 1;
+    } else {
+        /* the falloff is in the frames: the motion refined again with it */
+        home__refine_run_shaded(ctx, slot, trial->H, ctx->cfg.max_model, 0, &fit);
+        if (!similarity && fit.refine_status != HOME_REFINE_ACCEPTED) return 1;
+    }
     memcpy(st->score, shaded, sizeof st->score);
     *own_motion = shaded[3];
     if (fit.refine_status == HOME_REFINE_ACCEPTED) {
@@ -521,7 +528,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
              * HOME's lines 1-1.5 px off, the optimum 4-8 px away): neither can be vouched for */
             trial.ok = 0;
             trial.failure = HOME_FAIL_INCONSISTENT;
-        } else if (background_refutes(ctx, slot, &trial, &own_motion)) {
+        } else if (background_refutes(ctx, slot, &trial, stands_in, &own_motion)) {
             /* ... or the background would show the motion clearly, and shows far less of it
              * than predicted: the moving objects' motion over a still background */
             trial.ok = 0;

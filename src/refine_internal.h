@@ -135,9 +135,11 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, int patie
  * motion the frame's pixels give where a capped model misfits them. */
 void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
                                  home_result *result);
-/* The same (patient), fitting beside the motion a lens falloff fixed to the sensor,
- * s = 1 - kappa rho^2 (rho^2 = 1 at the corners): frames whose background shows one. */
-void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, home_result *result);
+/* The same (patient) up to max_model, fitting beside the motion a lens falloff fixed to the
+ * sensor, s = 1 - kappa rho^2 (rho^2 = 1 at the corners): frames whose background shows one,
+ * or a similarity standing in (stand_in: home__refine_run()'s conditions on it). */
+void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, int max_model,
+                             int stand_in, home_result *result);
 /* The same without the points of the regions excluded flags (the identity test's grid): the
  * motion of the rest of the frame. */
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,

@@ -1147,9 +1147,10 @@ void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
     refine_model(ctx, slot, h0, NULL, NULL, 0, 0, HOME_MODEL_HOMOGRAPHY, 0, result);
 }
 
-void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, home_result *result)
+void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, int max_model,
+                             int stand_in, home_result *result)
 {
-    refine_model(ctx, slot, h0, NULL, NULL, 1, 1, ctx->cfg.max_model, 0, result);
+    refine_model(ctx, slot, h0, NULL, NULL, 1, 1, max_model, stand_in, result);
 }
 
 double home__refine_run_without(home_context *ctx, int slot, const double *h0,

@@ -18,6 +18,7 @@
     X(static_scene_is_identity) X(shift_is_translation) X(model_cap) X(model_floor_weighs_perspective) \
     X(capped_perspective_is_one_motion) X(sigma_calibrated) X(few_edges_never_wrong) \
     X(few_edges_similarity_stands_in) X(few_edges_half_size_stand_ins) \
+    X(few_edges_lens_shading_stand_ins) \
     X(textured_mover_never_steers) X(static_fog_is_identity) X(raw_fog_never_moves) X(fence_never_aliased) \
     X(pegboard_never_aliased)
 
