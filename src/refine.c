@@ -225,6 +225,8 @@ static int background_refutes(home_context *ctx, int slot, home_result *trial, i
         if (!(stands_in && shaded[1] < BACKGROUND_EVIDENCE)) return 1;
         home__refine_run_shaded(ctx, slot, trial->H, HOME_MODEL_SIMILARITY, 1, &fit);
         if (fit.refine_status != HOME_REFINE_ACCEPTED) return 1;
+        /* its error stays at least what the stand-in's was (the spread of the probes' optima) */
+        if (fit.sigma_px < trial->sigma_px) fit.sigma_px = trial->sigma_px;
     } else {
         /* the falloff is in the frames: the motion refined again with it */
         home__refine_run_shaded(ctx, slot, trial->H, ctx->cfg.max_model, 0, &fit);
