@@ -314,6 +314,16 @@ void home__refine_background_matrix(const home__refine_state *st, const double *
                 m[3 * i + j] += to_level[3 * i + k] * t[3 * k + j];
 }
 
+/* The least-squares gain and bias (gain * v + bias ~ t) from the sums over n pixels of v, v^2,
+ * v t and t; a gain of 1 where v does not vary. */
+static void fit_gain_bias(double n, double sv, double svv, double svt, double st, double *gain,
+                          double *bias)
+{
+    const double var_v = svv - sv * sv / n, cov = svt - sv * st / n;
+    *gain = var_v > 1e-9 * n ? cov / var_v : 1.0;
+    *bias = (st - *gain * sv) / n;
+}
+
 /* rho^2 of background pixel (x, y): 0 at the centre, 1 at the corners */
 static double rho2(double x, double y, int w, int h)
 {
@@ -373,8 +383,7 @@ static double plain_falloff(const home__refine_state *st, const double *m, const
         svt += v * a[i];
         sa += a[i];
     }
-    *gain = svv - sv * sv / n > 1e-9 * n ? (svt - sv * sa / n) / (svv - sv * sv / n) : 1.0;
-    *bias = (sa - *gain * sv) / n;
+    fit_gain_bias(n, sv, svv, svt, sa, gain, bias);
     return kappa;
 }
 
@@ -402,12 +411,8 @@ double home__refine_plain_background(home_context *ctx, int slot, const double *
     sample_plain(st, slot, m, st->sampled, &acc);
     if (acc.n < PLAIN_MIN_PIXELS * (double)w * hh / (REGIONS_X * REGIONS_Y)) return 0.0;
     /* each estimate's gain and bias (alpha * B + beta ~ A), least squares over the same pixels */
-    for (e = 0; e < 2; e++) {
-        const double var_v = acc.vv[e] - acc.v[e] * acc.v[e] / acc.n;
-        const double cov = acc.vt[e] - acc.v[e] * acc.t / acc.n;
-        acc.gain[e] = var_v > 1e-9 * acc.n ? cov / var_v : 1.0;
-        acc.bias[e] = (acc.t - acc.gain[e] * acc.v[e]) / acc.n;
-    }
+    for (e = 0; e < 2; e++)
+        fit_gain_bias(acc.n, acc.v[e], acc.vv[e], acc.vt[e], acc.t, &acc.gain[e], &acc.bias[e]);
     kappa = fit_falloff ? plain_falloff(st, m, a, acc.n, &acc.gain[0], &acc.bias[0]) : 0.0;
     /* one scale for both: the identity's robust residual scale, not below the camera floor */
     for (i = 0; i < w * hh; i++) {
