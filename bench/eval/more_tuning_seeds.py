@@ -5,8 +5,9 @@ The tuning set has one to seven sequences per hard scene; a rule that fits them 
 other seeds. This renders consecutive-frame sequences of scenes.py's generator A (tuning) for
 seeds beyond the catalogue's (v20 on by default; the catalogue uses v0-v6), under the trust
 evaluation's conditions, runs home-register on every pair and prints failures, silent errors
-(ok but > 2 px off) and ok answers beyond 3 predicted errors, per condition. Generator B (the
-sealed test set's) is never used. docs/trust.md, session 34.
+(ok but > 2 px off) and ok answers beyond 3 predicted errors, per condition and per path
+(refine_status and model) of the ok answers. Generator B (the sealed test set's) is never
+used. docs/trust.md, sessions 34 and 35.
 
     python3 bench/eval/more_tuning_seeds.py --home build/bin/home-register \\
         [--kinds few_edges] [--conditions lens_shading,day] [--seeds 20:80] [--config video] \\
@@ -71,6 +72,21 @@ def main():
         mean = sum(o["err"] for o in ok) / len(ok) if ok else float("nan")
         print(f"| {cond} | {len(rs)} | {100 - 100 * len(ok) / len(rs):.1f} % | {silent} | "
               f"{beyond} | {mean:.3f} |")
+    # which path the ok answers took: a silent rate that one path concentrates shows here
+    paths = collections.defaultdict(lambda: [0, 0, 0])
+    for r in recs:
+        o = r["result"]
+        if o.get("ok"):
+            row = paths[(r["group"], o.get("refine_status"), o.get("model"))]
+            row[0] += 1
+            row[1] += o["err"] > trust.SILENT_PX
+            row[2] += o["err"] > 3 * o.get("sigma_px", 0.0)
+    print()
+    print("| condition | refine_status | model | ok | silent > 2 px | > 3 sigma |")
+    print("|---|---|---|---|---|---|")
+    for (cond, status, model), (n, silent, beyond) in sorted(paths.items(), key=str):
+        print(f"| {cond} | {status} | {model} | {n} | {silent} | {beyond} |")
+    print()
     for r in recs:
         o = r["result"]
         if o.get("ok") and o["err"] > trust.SILENT_PX:
