@@ -73,8 +73,9 @@ struct home_stab {
     int thumb_index;              /* thumb[thumb_index]: the newest frame's */
     float thumb[2][HOME__STAB_THUMB_CELLS]; /* coarse luma of the last two frames (cuts) */
     double q, r, norm;            /* process / measurement noise, px per radian or log-scale */
-    int still_exact;              /* a still frame's path is measured as the intended path (the
-                                     lookahead spans the time constant: stab_path.c) */
+    int sees_ahead;               /* the lookahead spans the path's time constant: a still
+                                     frame's path is measured as the intended one, and a held
+                                     frame's path glides on (stab_path.c) */
     home_context *key_home;       /* the key frame's registration (NULL: none) */
     uint8_t *key_luma;            /* the key frame: the last frame whose motion left nothing
                                      unexplained, away from frames that did (key_frame; -1:

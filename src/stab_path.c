@@ -20,9 +20,21 @@ void home__stab_path_components(const home_stab *st, const home_stab_sim *s, dou
  * a causal or short-sighted path would jump onto it at the end of a pan. */
 static double measurement_noise(const home_stab *st, const stab_slot *cur)
 {
-    if (st->still_exact && (cur->registered_still || cur->status == HOME_STAB_MOTION_STILL))
+    if (st->sees_ahead && (cur->registered_still || cur->status == HOME_STAB_MOTION_STILL))
         return STAB_STILL_VAR;
     return st->r * cur->weight;
+}
+
+/* A held frame's motion is unknown and taken as none. Where the path cannot see past the hold
+ * (causal, or a lookahead short of the time constant), it stands still with the frame: the
+ * frame keeps the correction of the one before and its output moves as its input did, where a
+ * path gliding on would add its own motion to the camera's (a camera sweeping 10-20 px a frame
+ * came out shakier than it went in). With the lookahead, the smoother sees the frames after
+ * the hold, which may bridge it, and glides over it. */
+static int path_holds(const home_stab *st, const stab_slot *s)
+{
+    return !st->sees_ahead &&
+           (s->status == HOME_STAB_MOTION_FAILED || s->status == HOME_STAB_MOTION_IMPLAUSIBLE);
 }
 
 /* One filter step for cur, measuring z (path components). */
@@ -31,6 +43,13 @@ void home__stab_kalman_step(const home_stab *st, const stab_slot *prev, stab_slo
 {
     double k0, k1, sv;
     int c;
+    if (prev && path_holds(st, cur)) { /* F = I, no process noise, no measurement */
+        memcpy(cur->xp, prev->xf, sizeof cur->xp);
+        memcpy(cur->xf, prev->xf, sizeof cur->xf);
+        memcpy(cur->pp, prev->pf, sizeof cur->pp);
+        memcpy(cur->pf, prev->pf, sizeof cur->pf);
+        return;
+    }
     if (!prev) {
         for (c = 0; c < 4; c++) {
             cur->xp[c][0] = cur->xf[c][0] = z[c];
@@ -169,6 +188,7 @@ home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last)
     memcpy(xs, slot_of(st, last)->xf, sizeof xs);
     for (k = last - 1; k >= m; k--) {
         const stab_slot *a = slot_of(st, k), *b = slot_of(st, k + 1);
+        if (path_holds(st, b)) continue; /* C = I: frame k's path is frame k + 1's */
         /* C = Pf F^T Pp(k+1)^-1 */
         double f00 = a->pf[0] + a->pf[1], f01 = a->pf[1], f10 = a->pf[1] + a->pf[2], f11 = a->pf[2];
         double det = b->pp[0] * b->pp[2] - b->pp[1] * b->pp[1];

@@ -270,7 +270,7 @@ int home_stab_init(home_stab **out, const home_stab_config *cfg, void *arena, si
     /* Kalman bandwidth ~ (q/r)^(1/4) per frame for the constant-velocity model */
     st->r = 1.0;
     st->q = 1.0 / pow(stab_time_constant(cfg), 4.0);
-    st->still_exact = cfg->lookahead >= stab_time_constant(cfg);
+    st->sees_ahead = cfg->lookahead >= stab_time_constant(cfg);
     st->norm = 0.5 * sqrt((double)cfg->width * cfg->width + (double)cfg->height * cfg->height);
     st->magic = STAB_MAGIC;
     *out = st;

@@ -1181,6 +1181,51 @@ static void test_hold_bridged(void)
     }
 }
 
+/* Causal, the path cannot see past a hold: a held frame's motion is taken as none and the path
+ * stands still with it, so the frame keeps the correction of the frame before and its output
+ * moves as its input did. A path that glided on through the hold would add its own motion to
+ * the camera's (a camera sweeping 10-20 px a frame over two long edges came out shakier than
+ * it went in). A pan of 5 px a frame, frames 30-33 flat. */
+static void test_held_frame_keeps_correction(void)
+{
+    enum { FRAMES = 48, FLAT_FROM = 30, FLAT_TO = 33 };
+    static uint8_t frame[CW * CH * 3 / 2];
+    home_stab *st = make_stab(0, 1, 0);
+    home_stab_output o;
+    home_stab_image im;
+    home_stab_sim prev_smooth = {0, 0, 0, 0};
+    double prev_warp[6] = {0, 0, 0, 0, 0, 0}, worst_held = 0.0, path_speed = 1e9;
+    int t, held = 0;
+    CHECK(st != NULL);
+    if (!st) return;
+    for (t = 0; t < FRAMES; t++) {
+        double h[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, step;
+        h[2] = -5.0 * t;
+        synth_render(SYNTH_STRUCTURED, 3, h, 1.0, (uint64_t)t + 7, frame, CW, CH, CW);
+        if (t >= FLAT_FROM && t <= FLAT_TO) memset(frame, 100, CW * CH);
+        memset(frame + CW * CH, 128, CW * CH / 2);
+        grey_image(frame, &im);
+        CHECK_EQ_INT(home_stab_push(st, &im, &o), HOME_OK);
+        CHECK(o.ready && o.frame == t);
+        step = hypot(o.warp[2] - prev_warp[2], o.warp[5] - prev_warp[5]);
+        if (o.motion_status == HOME_STAB_MOTION_FAILED ||
+            o.motion_status == HOME_STAB_MOTION_IMPLAUSIBLE) {
+            held++;
+            if (step > worst_held) worst_held = step;
+        } else if (t > 10 && t < FLAT_FROM) { /* the path's own motion: it pans with the camera */
+            const double v = hypot(o.smooth.tx - prev_smooth.tx, o.smooth.ty - prev_smooth.ty);
+            if (v < path_speed) path_speed = v;
+        }
+        memcpy(prev_warp, o.warp, sizeof prev_warp);
+        prev_smooth = o.smooth;
+    }
+    printf("    %d frames held, their correction moved at most %.2g px (the path moves at least "
+           "%.2f px a frame before the hold)\n", held, worst_held, path_speed);
+    CHECK(held >= 4);
+    CHECK_LT(worst_held, 1e-6);
+    CHECK(path_speed > 4.0);
+}
+
 /* With the camera shaking, HOME refuses motions the hand's plain area does not show; where the
  * frames around them register a moving camera, the stabiliser takes them (restored), and each
  * is the camera's motion, not the hand's. On a tripod the same hand restores nothing. */
@@ -1260,7 +1305,8 @@ static void test_object_does_not_steer(void)
     X(warp_formats_agree) X(warp_bands_match_whole) X(jitter_reduced_causal) X(horizon_in_fog_partial) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
     X(deterministic) X(static_camera_moving_object) X(tripod_pan_keeps_still_frames) X(static_fog_with_objects) X(cut_restarts_path) X(caller_cut) \
-    X(no_cut_on_exposure_or_fade) X(crop_after_the_fact) X(hand_at_lens_followed) X(object_does_not_steer) X(hold_bridged)
+    X(no_cut_on_exposure_or_fade) X(crop_after_the_fact) X(hand_at_lens_followed) X(object_does_not_steer) X(hold_bridged) \
+    X(held_frame_keeps_correction)
 #define ENTRY(name) {#name, test_##name},
 static const test_case tests[] = {STAB_TESTS(ENTRY)};
 
