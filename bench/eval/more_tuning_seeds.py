@@ -31,6 +31,16 @@ from common import parallel_map  # noqa: E402
 CACHE = Path(os.environ.get("HOME_EVAL_CACHE", HERE.parents[1] / "build" / "eval-cache"))
 
 
+def silent(o):
+    """An ok answer more than 2 px off."""
+    return o["err"] > trust.SILENT_PX
+
+
+def beyond_3_sigma(o):
+    """An ok answer off by more than 3 predicted errors."""
+    return o["err"] > 3 * o.get("sigma_px", 0.0)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--home", default=str(HERE.parents[1] / "build/bin/home-register"))
@@ -67,11 +77,9 @@ def main():
     print("|---|---|---|---|---|---|")
     for cond, rs in groups.items():
         ok = [r["result"] for r in rs if r["result"].get("ok")]
-        silent = sum(o["err"] > trust.SILENT_PX for o in ok)
-        beyond = sum(o["err"] > 3 * o.get("sigma_px", 0.0) for o in ok)
         mean = sum(o["err"] for o in ok) / len(ok) if ok else float("nan")
-        print(f"| {cond} | {len(rs)} | {100 - 100 * len(ok) / len(rs):.1f} % | {silent} | "
-              f"{beyond} | {mean:.3f} |")
+        print(f"| {cond} | {len(rs)} | {100 - 100 * len(ok) / len(rs):.1f} % | "
+              f"{sum(map(silent, ok))} | {sum(map(beyond_3_sigma, ok))} | {mean:.3f} |")
     # which path the ok answers took: a silent rate that one path concentrates shows here
     paths = collections.defaultdict(lambda: [0, 0, 0])
     for r in recs:
@@ -79,17 +87,17 @@ def main():
         if o.get("ok"):
             row = paths[(r["group"], o.get("refine_status"), o.get("model"))]
             row[0] += 1
-            row[1] += o["err"] > trust.SILENT_PX
-            row[2] += o["err"] > 3 * o.get("sigma_px", 0.0)
+            row[1] += silent(o)
+            row[2] += beyond_3_sigma(o)
     print()
     print("| condition | refine_status | model | ok | silent > 2 px | > 3 sigma |")
     print("|---|---|---|---|---|---|")
-    for (cond, status, model), (n, silent, beyond) in sorted(paths.items(), key=str):
-        print(f"| {cond} | {status} | {model} | {n} | {silent} | {beyond} |")
+    for (cond, status, model), (n, n_silent, n_beyond) in sorted(paths.items(), key=str):
+        print(f"| {cond} | {status} | {model} | {n} | {n_silent} | {n_beyond} |")
     print()
     for r in recs:
         o = r["result"]
-        if o.get("ok") and o["err"] > trust.SILENT_PX:
+        if o.get("ok") and silent(o):
             print(f"silent: {r['image']} {r['group']} #{r['idx']}: {o['err']:.2f} px at a "
                   f"predicted {o['sigma_px']:.3f} ({o.get('refine_status')}, {o.get('model')})")
     if args.json:
