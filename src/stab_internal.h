@@ -39,6 +39,8 @@ typedef struct stab_slot {
     double pf[3], pp[3];          /* shared covariances {p00, p01, p11} */
     home_stab_sim motion;         /* the motion from the previous frame taken (0 when held) */
     int registered_still;         /* the registration was the identity */
+    double ease;                  /* still, but next to the camera's move: how far the path may
+                                     leave it (0: pinned, 1: an ordinary frame; stab_path.c) */
     int has_candidate;            /* held, refused only because the plain background stood still: */
     home_stab_sim candidate;      /* the refused motion, plausible, */
     double candidate_weight;      /* and the weight it would have */
@@ -107,6 +109,9 @@ void home__stab_path_components(const home_stab *st, const home_stab_sim *s, dou
 void home__stab_kalman_step(const home_stab *st, const stab_slot *prev, stab_slot *cur,
                             const double *z);
 void home__stab_refilter_mirrored_start(const home_stab *st, long first, long last);
+void home__stab_refilter(const home_stab *st, long t, long newest);
+void home__stab_ease_still(home_stab *st, long t, long newest);
+double home__stab_ease_after_move(const home_stab *st, long n);
 void home__stab_end_segment(home_stab *st, long last);
 home_stab_sim home__stab_smoothed_path(const home_stab *st, long m, long last);
 

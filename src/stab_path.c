@@ -1,14 +1,24 @@
 /* The camera path: a constant-velocity Kalman filter per component, fixed-lag RTS smoothing
  * over the lookahead, and the stream's ends mirrored so that they are smoothed like the rest. */
 #include "stab_internal.h"
+#include <math.h>
 #include <string.h>
 
 #define STAB_INIT_VEL_VAR 1.0             /* prior variance of the path velocity, (px/frame)^2 */
 #define STAB_STILL_VAR 1e-6               /* a still frame's path measurement variance, px^2 */
+#define STAB_EASE_BEFORE 13               /* still frames this close before the camera moves */
+#define STAB_EASE_AFTER 13                /* ... or after it stopped are pinned the less the
+                                             closer they are: the path eases over them
+                                             (bench/stab/README.md, session 37) */
 
 void home__stab_path_components(const home_stab *st, const home_stab_sim *s, double *z)
 {
     z[0] = s->tx; z[1] = s->ty; z[2] = s->angle * st->norm; z[3] = s->log_scale * st->norm;
+}
+
+static int is_still(const stab_slot *s)
+{
+    return s->registered_still || s->status == HOME_STAB_MOTION_STILL;
 }
 
 /* The variance of a frame's path measurement: the intended path plus shake of variance r, more
@@ -17,12 +27,78 @@ void home__stab_path_components(const home_stab *st, const home_stab_sim *s, dou
  * intended one, so a tripod shot's still stretches stay still in the output instead of taking
  * up part of a pan that starts or ends next to them. Only where the lookahead spans the time
  * constant: the smoother then sees a still frame coming early enough to meet it smoothly, where
- * a causal or short-sighted path would jump onto it at the end of a pan. */
+ * a causal or short-sighted path would jump onto it at the end of a pan. The still frames
+ * nearest the move are pinned less (their ease share): a camera that starts or stops within a
+ * frame or two is then eased into and out of over a few still frames, not within the move. */
 static double measurement_noise(const home_stab *st, const stab_slot *cur)
 {
-    if (st->sees_ahead && (cur->registered_still || cur->status == HOME_STAB_MOTION_STILL))
-        return STAB_STILL_VAR;
+    if (st->sees_ahead && is_still(cur)) {
+        if (!(cur->ease > 0.0)) return STAB_STILL_VAR;
+        /* geometric between the two: the information grows by equal steps */
+        return exp(cur->ease * log(st->r * cur->weight) + (1.0 - cur->ease) * log(STAB_STILL_VAR));
+    }
     return st->r * cur->weight;
+}
+
+/* Re-run the filter over frames t..newest of the segment (their measurements changed). */
+void home__stab_refilter(const home_stab *st, long t, long newest)
+{
+    const long first = st->first, lookahead = st->cfg.lookahead;
+    double z[4];
+    long i;
+    /* the mirrored start reflects the segment's first lookahead frames */
+    if (lookahead > 0 && newest - first >= lookahead && t - first <= lookahead) {
+        home__stab_refilter_mirrored_start(st, first, newest);
+        return;
+    }
+    for (i = t; i <= newest; i++) {
+        home__stab_path_components(st, &slot_of(st, i)->raw, z);
+        home__stab_kalman_step(st, slot_of(st, i - 1), slot_of(st, i), z);
+    }
+}
+
+static int moves(const stab_slot *s)
+{
+    return (s->status == HOME_STAB_MOTION_OK && !s->registered_still) ||
+           s->status == HOME_STAB_MOTION_RESTORED || s->status == HOME_STAB_MOTION_BRIDGED;
+}
+
+/* How far a still frame's path may leave the camera's, d frames from the camera's move within
+ * `reach` of it: 1 (an ordinary frame) next to the move, down to 0 (pinned) beyond the reach. */
+static double ease_share(long d, long reach)
+{
+    return d <= reach ? (double)(reach + 1 - d) / (double)(reach + 1) : 0.0;
+}
+
+/* Frame n, just pushed: its ease share when it is still, within STAB_EASE_AFTER of the camera's
+ * move. Decided as it arrives: a still frame pinned at the lookahead's edge would pull the
+ * frames due before it onto itself at once. */
+double home__stab_ease_after_move(const home_stab *st, long n)
+{
+    long i;
+    if (!st->sees_ahead || !is_still(slot_of(st, n))) return 0.0;
+    for (i = n - 1; i >= n - STAB_EASE_AFTER && i > st->first && slot_of(st, i)->frame == i; i--)
+        if (moves(slot_of(st, i))) return ease_share(n - i, STAB_EASE_AFTER);
+    return 0.0;
+}
+
+/* Frame t's motion is settled (home__stab_settle_still()). When the camera moves at t, the still
+ * frames just before it are pinned less the closer they are: a camera that starts within a
+ * frame or two (a tripod's pan, a hand lifting the camera) would otherwise be eased into within
+ * the first frames of the move, and that ease is shake. Only frames not yet emitted change. */
+void home__stab_ease_still(home_stab *st, long t, long newest)
+{
+    long i, from = newest + 1;
+    if (!st->sees_ahead || t <= st->first || !moves(slot_of(st, t))) return;
+    for (i = t - 1; i >= t - STAB_EASE_BEFORE && i > st->first && i >= st->emitted; i--) {
+        stab_slot *s = slot_of(st, i);
+        const double share = ease_share(t - i, STAB_EASE_BEFORE);
+        if (is_still(s) && share > s->ease) {
+            s->ease = share;
+            from = i;
+        }
+    }
+    if (from <= newest) home__stab_refilter(st, from, newest);
 }
 
 /* A held frame's motion is unknown and taken as none. Where the path cannot see past the hold
@@ -131,6 +207,7 @@ void home__stab_refilter_mirrored_start(const home_stab *st, long first, long la
     v[0].weight = v[1].weight = 1.0;
     v[0].status = v[1].status = HOME_STAB_MOTION_OK;
     v[0].registered_still = v[1].registered_still = 0;
+    v[0].ease = v[1].ease = 0.0;
     path_trend(st, first, first + k, trend);
     for (i = first - k; i <= last; i++) {
         stab_slot *cur = i < first ? &v[(first - i) & 1] : slot_of(st, i);
@@ -157,6 +234,7 @@ static void append_mirrored_end(home_stab *st, long first, long last)
         cur->status = HOME_STAB_MOTION_OK;
         cur->weight = 1.0;
         cur->registered_still = 0;
+        cur->ease = 0.0;
         cur->smoothed_ready = 0;
         home__stab_kalman_step(st, slot_of(st, last + i - 1), cur, z);
     }

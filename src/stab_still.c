@@ -63,25 +63,15 @@ static int is_lone(const home_stab *st, long t, long newest)
 void home__stab_retake_motion(home_stab *st, long t, long newest, const home_stab_sim *m,
                               int status, double weight)
 {
-    const long first = st->first, lookahead = st->cfg.lookahead;
     stab_slot *s = slot_of(st, t);
     long i;
-    double z[4];
     s->motion = *m;
     s->status = status;
     s->weight = weight;
     for (i = t; i <= newest; i++)
         slot_of(st, i)->raw = home__stab_sim_compose(&slot_of(st, i)->motion,
                                                      &slot_of(st, i - 1)->raw);
-    /* the mirrored start reflects the segment's first lookahead frames */
-    if (lookahead > 0 && newest - first >= lookahead && t - first <= lookahead) {
-        home__stab_refilter_mirrored_start(st, first, newest);
-        return;
-    }
-    for (i = t; i <= newest; i++) {
-        home__stab_path_components(st, &slot_of(st, i)->raw, z);
-        home__stab_kalman_step(st, slot_of(st, i - 1), slot_of(st, i), z);
-    }
+    home__stab_refilter(st, t, newest);
 }
 
 /* A frame's score test on a plain background: the motion's expected score rests on many

@@ -304,6 +304,7 @@ static void end_segment(home_stab *st, long last)
     for (t = last - home__stab_still_delay(st) + 1; t <= last; t++) {
         home__stab_settle_still(st, t, last);
         home__stab_settle_restored(st, t, last);
+        home__stab_ease_still(st, t, last);
     }
     home__stab_end_segment(st, last);
 }
@@ -742,6 +743,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     memcpy(slot->score, score, sizeof score);
     slot->unexplained = unexplained;
     slot->smoothed_ready = 0;
+    slot->ease = n > st->first ? home__stab_ease_after_move(st, n) : 0.0;
     if (n == st->first) {
         memset(&slot->raw, 0, sizeof slot->raw);
         home__stab_path_components(st, &slot->raw, z);
@@ -774,6 +776,7 @@ int home_stab_push(home_stab *st, const home_stab_image *frame, home_stab_output
     }
     home__stab_settle_still(st, n - home__stab_still_delay(st), n);
     home__stab_settle_restored(st, n - home__stab_still_delay(st), n);
+    home__stab_ease_still(st, n - home__stab_still_delay(st), n);
     if (n - st->first == st->cfg.lookahead) home__stab_refilter_mirrored_start(st, st->first, n);
     if (n - st->emitted >= st->cfg.lookahead) emit(st, n, out);
     return HOME_OK;

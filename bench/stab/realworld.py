@@ -18,7 +18,9 @@ Scenarios (each in the tuning and the test half, with other scenes and seeds):
   fade       a fade to black and back, then a 10-frame dissolve, between three shots
   exposure   gain steps of +-1 EV every 30 frames; a slow auto-exposure ramp (-1 to +1 EV)
   codec      libx264 at 1.5 Mbit/s; libx265 at 1 Mbit/s (30 fps), decoded back to Y4M
-  zoom, pan  an intended slow zoom in to 1.25x and out again; a 200 px pan with a 80 px tilt
+  zoom, pan  an intended slow zoom in to 1.25x and out again; a 200 px pan with a 80 px tilt;
+             a still camera that moves 63 px hand-held (frames 30-75, at full speed within 2
+             frames) and stands still again (still_move)
   scene      the earlier rendered cases: few long edges, horizon in fog, structured,
              textured, low light (scenes.low_light instead of the noise)
 Real footage (no truth), visp-images-data's camera sequences at their native size (cropped to
@@ -144,6 +146,13 @@ def motion(ctx, frames, seed, kind="bench"):
         scale = 1 + 0.25 * ease(2 * u) - 0.25 * ease(2 * u - 1)
     elif kind == "pan":           # a deliberate pan right-to-left and a tilt, eased
         want = np.stack([100 - 200 * ease(u), -40 + 80 * ease(u), np.zeros(frames)], 1)
+    elif kind == "still_move":    # still, a hand-held move that starts within 2 frames, still
+        start, stop = frames // 4, frames // 4 + 45
+        t = np.arange(frames)
+        speed = np.clip(np.minimum((t - start + 1) / 2, (stop - t) / 3), 0, 1)
+        walk = np.cumsum(speed) / speed.sum()
+        want = np.stack([60 * walk, -20 * walk, np.zeros(frames)], 1)
+        jit = jit * ((t >= start) & (t <= stop))[:, None]
     else:
         raise ValueError(kind)
     g = [camera(*(want[t] + jit[t]), scale[t]) for t in range(frames)]
@@ -466,6 +475,10 @@ def catalogue():
             src(what), build_scene(item(photo=what), seed, kind="zoom"), 150)
         add("pan_%s" % half, half, "pan", "intended 200 px pan and 80 px tilt, plus shake",
             src(what), build_scene(item(photo=what), seed + 1, kind="pan"), 150)
+    for half, what, seed in (("tuning", motorcycle, 171), ("test", flowers, 181)):
+        add("still_move_%s" % half, half, "pan", "still, a 63 px hand-held move that starts "
+            "within 2 frames (frames 30-75), still again", src(what),
+            build_scene(item(photo=what), seed, kind="still_move"))
     for half, v, scenes in (
             ("tuning", "A", [("flat_art", S("few_edges", "A", "rw0"), 151, False),
                              ("fog_horizon", S("fog_horizon", "A", "rw0"), 152, False),
