@@ -10,6 +10,7 @@
 #define STAB_EASE_AFTER 13                /* ... or after it stopped are pinned the less the
                                              closer they are: the path eases over them
                                              (bench/stab/README.md, session 37) */
+#define STAB_EASE_MOVE_PX 1.0             /* a move: the frame's corners moved this far, px RMS */
 
 void home__stab_path_components(const home_stab *st, const home_stab_sim *s, double *z)
 {
@@ -57,10 +58,13 @@ void home__stab_refilter(const home_stab *st, long t, long newest)
     }
 }
 
-static int moves(const stab_slot *s)
+/* Did the camera move from frame s's predecessor to s by STAB_EASE_MOVE_PX or more? A smaller
+ * motion is no start or end of a move to ease over. */
+static int moves(const home_stab *st, const stab_slot *s)
 {
-    return (s->status == HOME_STAB_MOTION_OK && !s->registered_still) ||
-           s->status == HOME_STAB_MOTION_RESTORED || s->status == HOME_STAB_MOTION_BRIDGED;
+    return ((s->status == HOME_STAB_MOTION_OK && !s->registered_still) ||
+            s->status == HOME_STAB_MOTION_RESTORED || s->status == HOME_STAB_MOTION_BRIDGED) &&
+           home__stab_corner_motion(st, &s->motion) >= STAB_EASE_MOVE_PX;
 }
 
 /* How far a still frame's path may leave the camera's, d frames from the camera's move within
@@ -78,7 +82,7 @@ double home__stab_ease_after_move(const home_stab *st, long n)
     long i;
     if (!st->sees_ahead || !is_still(slot_of(st, n))) return 0.0;
     for (i = n - 1; i >= n - STAB_EASE_AFTER && i > st->first && slot_of(st, i)->frame == i; i--)
-        if (moves(slot_of(st, i))) return ease_share(n - i, STAB_EASE_AFTER);
+        if (moves(st, slot_of(st, i))) return ease_share(n - i, STAB_EASE_AFTER);
     return 0.0;
 }
 
@@ -89,7 +93,7 @@ double home__stab_ease_after_move(const home_stab *st, long n)
 void home__stab_ease_still(home_stab *st, long t, long newest)
 {
     long i, from = newest + 1;
-    if (!st->sees_ahead || t <= st->first || !moves(slot_of(st, t))) return;
+    if (!st->sees_ahead || t <= st->first || !moves(st, slot_of(st, t))) return;
     for (i = t - 1; i >= t - STAB_EASE_BEFORE && i > st->first && i >= st->emitted; i--) {
         stab_slot *s = slot_of(st, i);
         const double share = ease_share(t - i, STAB_EASE_BEFORE);

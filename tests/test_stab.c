@@ -727,11 +727,11 @@ static void test_static_camera_moving_object(void)
     CHECK_LT(worst, 0.05);
 }
 
-/* A tripod shot that pans 3 px a frame over frames 21-34 and stands still before and after it:
- * the smoothed path of each frame, and its status, with the given lookahead. */
+/* A tripod shot that pans `speed` px a frame over frames 21-34 and stands still before and
+ * after it: the smoothed path of each frame, and its status, with the given lookahead. */
 enum { TRIPOD_FRAMES = 60, TRIPOD_PAN_FROM = 20, TRIPOD_PAN_TO = 34 };
 
-static void run_tripod_pan(int lookahead, home_stab_sim *smooth, int *status)
+static void run_tripod_pan(int lookahead, double speed, home_stab_sim *smooth, int *status)
 {
     static uint8_t frame[CW * CH * 3 / 2];
     home_stab *st = make_stab(lookahead, 1, 0);
@@ -746,7 +746,7 @@ static void run_tripod_pan(int lookahead, home_stab_sim *smooth, int *status)
         if (t < TRIPOD_FRAMES) {
             double h[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
             if (t > TRIPOD_PAN_FROM)
-                pan_x = 3.0 * ((t < TRIPOD_PAN_TO ? t : TRIPOD_PAN_TO) - TRIPOD_PAN_FROM);
+                pan_x = speed * ((t < TRIPOD_PAN_TO ? t : TRIPOD_PAN_TO) - TRIPOD_PAN_FROM);
             h[2] = -pan_x;
             synth_render(SYNTH_STRUCTURED, 9, h, 2.5, (uint64_t)t + 100, frame, CW, CH, CW);
             memset(frame + CW * CH, 128, CW * CH / 2);
@@ -792,7 +792,7 @@ static void test_tripod_pan_keeps_still_frames(void)
     static int status[TRIPOD_FRAMES];
     double before = 0.0, after = 0.0, causal = 0.0, jerk = 0.0;
     int t, ok = 0;
-    run_tripod_pan(15, smooth, status);
+    run_tripod_pan(15, 3.0, smooth, status);
     for (t = 1; t < TRIPOD_FRAMES; t++) {
         ok += status[t] == HOME_STAB_MOTION_OK;
         if (t <= TRIPOD_PAN_FROM - 13 && smoothed_step(smooth, t) > before)
@@ -802,7 +802,7 @@ static void test_tripod_pan_keeps_still_frames(void)
         if (t + 1 < TRIPOD_FRAMES && smoothed_jerk(smooth, t) > jerk)
             jerk = smoothed_jerk(smooth, t);
     }
-    run_tripod_pan(0, smooth, status);
+    run_tripod_pan(0, 3.0, smooth, status);
     for (t = TRIPOD_PAN_TO + 1; t < TRIPOD_FRAMES; t++)
         if (smoothed_step(smooth, t) > causal) causal = smoothed_step(smooth, t);
     printf("    lookahead 15: %d of %d frames ok, largest output motion a frame %.4f px before "
@@ -813,6 +813,23 @@ static void test_tripod_pan_keeps_still_frames(void)
     CHECK_LT(after, 0.05);
     CHECK_LT(jerk, 0.75);
     CHECK_LT(causal, 3.0);
+}
+
+/* A drift of 0.5 px a frame is no move to ease into: the still frames before and after it stay
+ * pinned, and the output stands still there (easing them, it moved 0.24 px in a frame). */
+static void test_slow_drift_keeps_still_frames(void)
+{
+    static home_stab_sim smooth[TRIPOD_FRAMES];
+    static int status[TRIPOD_FRAMES];
+    double still = 0.0;
+    int t;
+    run_tripod_pan(15, 0.5, smooth, status);
+    for (t = 1; t < TRIPOD_FRAMES; t++)
+        if ((t <= TRIPOD_PAN_FROM || t > TRIPOD_PAN_TO + 1) && smoothed_step(smooth, t) > still)
+            still = smoothed_step(smooth, t);
+    printf("    lookahead 15, a 0.5 px a frame drift: largest output motion a frame outside it "
+           "%.4f px\n", still);
+    CHECK_LT(still, 0.01);
 }
 
 /* A tripod shot of fog with textured objects crossing it, a live camera's frames (new noise in
@@ -1317,7 +1334,7 @@ static void test_object_does_not_steer(void)
     X(api_contract) X(row_kernel_edges) X(warp_identity_and_shift) X(warp_matches_reference) \
     X(warp_formats_agree) X(warp_bands_match_whole) X(jitter_reduced_causal) X(horizon_in_fog_partial) X(lookahead_latency_and_gain) X(more_latency_never_shakier) X(refine_ending_at_half_size) \
     X(downscaled_registration) X(fewer_theta_bins) X(hold_on_failure) X(implausible_jump_held) X(ends_mirrored) \
-    X(deterministic) X(static_camera_moving_object) X(tripod_pan_keeps_still_frames) X(static_fog_with_objects) X(cut_restarts_path) X(caller_cut) \
+    X(deterministic) X(static_camera_moving_object) X(tripod_pan_keeps_still_frames) X(slow_drift_keeps_still_frames) X(static_fog_with_objects) X(cut_restarts_path) X(caller_cut) \
     X(no_cut_on_exposure_or_fade) X(crop_after_the_fact) X(hand_at_lens_followed) X(object_does_not_steer) X(hold_bridged) \
     X(held_frame_keeps_correction)
 #define ENTRY(name) {#name, test_##name},
