@@ -320,9 +320,9 @@ typedef struct home_result {
  * whole frame (also refine_inlier_share >= 0.9) and a second refinement, started halfway
  * between the two, reaches it too (within 3 sigma_px, at least 0.5 px), else the pair fails
  * (HOME_FAIL_INCONSISTENT). Where HOME's own estimate was not ok and the refined H is a
- * homography, its sigma_px is at least the largest distance to the optima that refinements
- * started 4 px to either side of it along each axis reach and vouch for (a few dim edges leave
- * several).
+ * homography, or any model under a max_model below the homography, its sigma_px is at least the
+ * largest distance to the optima that refinements started 4 px to either side of it along each
+ * axis reach and vouch for (a few dim edges leave several).
  * A refinement that cannot converge although the frame has texture refutes HOME's estimate
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the

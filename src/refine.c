@@ -392,9 +392,9 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
          * uncertainty is the trust floor; and not for a homography, whose perspective nothing
          * but the photometric fit then fixes (a few dim edges: 11 of the tuning set's 12 such
          * answers were 1.9-9.4 px off at a predicted 0.2-0.4 px, docs/trust.md session 23) */
-        if (trial.refined && stood_in) {
-            /* a similarity standing in: its error is at least the spread of the optima other
-             * starts reach (vouches() then holds it to the bound) */
+        if (trial.refined && (stood_in || ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
+            /* a similarity standing in, or a capped model: its error is at least the spread
+             * of the optima other starts reach (vouches() then holds it to the bound) */
             const double spread = probe_spread(ctx, slot, &trial, 1);
             if (spread > trial.sigma_px) trial.sigma_px = spread;
         }
@@ -431,9 +431,12 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
         } else if (agrees ? result->ok || vouches(ctx, &trial, 0)
                           : vouches(ctx, &trial, 1) &&
                                 same_optimum(ctx, slot, result->H, patient, &trial)) {
-            /* a homography on the photometric evidence alone, or a similarity standing in for
-             * one: its error is at least the spread of the optima other starts reach */
-            if (!result->ok && (trial.model == HOME_MODEL_HOMOGRAPHY || stood_in)) {
+            /* a homography on the photometric evidence alone, a similarity standing in for
+             * one, or a model capped below it (the stabiliser's: a few dim edges fix a
+             * similarity's optimum no better than a homography's, docs/trust.md session 37):
+             * its error is at least the spread of the optima other starts reach */
+            if (!result->ok && (trial.model == HOME_MODEL_HOMOGRAPHY || stood_in ||
+                                ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
                 const double spread = probe_spread(ctx, slot, &trial, stood_in);
                 if (spread > trial.sigma_px) trial.sigma_px = spread;
             }

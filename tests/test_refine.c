@@ -746,6 +746,53 @@ void test_few_edges_dim_calibrated(void)
     CHECK(ok >= 6); /* not vacuous */
 }
 
+/* The few dim edges of few_edges_dim_calibrated, low light only, under the stabiliser's
+ * similarity cap (max_model below the homography), a similarity between the frames: HOME's
+ * lines are rarely ok there, and the similarity the refinement reaches from them rests on the
+ * pixels alone. Its error is now at least the spread of the optima other starts reach, as a
+ * homography's is: of 60 frames, 11 of 25 ok answers were beyond 3 predicted errors (0.57-4.8
+ * px off at 0.12-0.25 px), 4 of 18 still are (docs/trust.md, session 37: a bias the probes do
+ * not see). */
+void test_capped_few_edges_dim_calibrated(void)
+{
+    home_config cfg;
+    home_context *ctx;
+    int k, ok = 0, misses = 0;
+    home_default_config(&cfg, IMG_W, IMG_H);
+    cfg.max_model = HOME_MODEL_SIMILARITY;
+    ctx = context(&cfg);
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 240; k += 4) {
+        const double cx = 0.5 * (IMG_W - 1), cy = 0.5 * (IMG_H - 1);
+        synth_rng rng, scene;
+        home_result res;
+        double h[9], err, gain, angle, tx, ty;
+        synth_seed(&scene, 4000 + (uint64_t)(k / 8));
+        synth_seed(&rng, 4100 + (uint64_t)k);
+        tx = 1.0 + 3.0 * synth_uniform(&rng);
+        ty = 3.0 * (synth_uniform(&rng) - 0.5);
+        angle = 0.004 * (synth_uniform(&rng) - 0.5);
+        h[0] = cos(angle); h[1] = -sin(angle); h[2] = cx + tx - h[0] * cx - h[1] * cy;
+        h[3] = sin(angle); h[4] = cos(angle); h[5] = cy + ty - h[3] * cx - h[4] * cy;
+        h[6] = 0.0; h[7] = 0.0; h[8] = 1.0;
+        gain = 0.10 + 0.15 * synth_uniform(&rng);
+        render_few_edges_dim(&scene, identity, gain, 4200 + 2 * (uint64_t)k, img_a);
+        render_few_edges_dim(&scene, h, gain, 4201 + 2 * (uint64_t)k, img_b);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
+        if (!res.ok) continue;
+        ok++;
+        if (err > 3.0 * res.sigma_px) {
+            misses++;
+            printf("     frame %3d: %s, %d inliers, error %.3f px, sigma %.3f px\n", k,
+                   home_model_name(res.model), res.inliers, err, res.sigma_px);
+        }
+    }
+    printf("     %d of 60 ok, %d beyond 3 predicted errors\n", ok, misses);
+    CHECK(ok >= 10); /* not vacuous */
+    CHECK(misses <= 4);
+}
+
 /* Lens shading: a falloff towards the corners of 15-40 %, fixed to the sensor, on frames A and
  * B (the rest of the pixels as rendered), then camera noise 2. */
 static void shade_and_noise(uint8_t *im, double falloff, uint64_t seed)
@@ -1270,7 +1317,7 @@ void test_refine_bad_inputs(void)
 
 #define TEST_LIST(X) \
     X(kernels_match_references) X(arena_and_config) X(region_grid_exact) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
-    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) X(dense_lens_shading) X(lens_shading_pans_and_tripods) X(plain_test_fits_lens_falloff) X(few_edges_dim_calibrated) \
+    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) X(dense_lens_shading) X(lens_shading_pans_and_tripods) X(plain_test_fits_lens_falloff) X(few_edges_dim_calibrated) X(capped_few_edges_dim_calibrated) \
     X(trust_region) X(video_equals_pair) X(kept_snapshot) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
 
