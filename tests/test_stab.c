@@ -784,8 +784,9 @@ static double smoothed_jerk(const home_stab_sim *smooth, int t)
  * stopped (2.7 px before the first frame of a move on a real clip). Only the still frames next
  * to the pan (13 before it and after it, pinned the more the farther) are eased over, so that a
  * pan that starts at full speed is not eased into within its first frames (with every still
- * frame pinned, the output's motion changed by 0.87 px a frame in a frame; now 0.63). Causal, the path cannot see the end of the pan coming and must not jump onto
- * the still frames after it: it glides on. */
+ * frame pinned, the output's motion changed by 0.87 px a frame in a frame; now 0.63). Causal,
+ * the path cannot see the end of the pan coming and must not jump onto the still frames after
+ * it: it glides on. */
 static void test_tripod_pan_keeps_still_frames(void)
 {
     static home_stab_sim smooth[TRIPOD_FRAMES];
