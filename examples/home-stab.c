@@ -40,7 +40,7 @@ static void usage(FILE *f)
             "  --lookahead N     frames of latency for fixed-lag smoothing (default 30: a file\n"
             "                    has no latency constraint; 0 = causal, as a live camera)\n"
             "  --ease F          with a lookahead: share of the pan given up at the clip's ends,\n"
-            "                    0 (keep panning) .. 1 (start from and come to rest); default 0.6\n"
+            "                    0 (keep panning) .. 1 (start from and come to rest); default 1\n"
             "  --downscale N     register on luma downscaled by 1, 2 or 4 (default: 2 above 960 px)\n"
             "  --keypoints N     HOME keypoints per sign (default 500)\n"
             "  --no-refine       skip HOME's photometric refinement of each registration\n"

@@ -88,7 +88,7 @@ typedef struct home_stab_config {
     float ease;               /* with a lookahead: share of the pan the virtual camera gives up
                                  at the stream's ends, 0..1 (0: the pan goes on through the
                                  first and last frames, 1: it starts from and comes to rest);
-                                 0.6. The path beyond each end is the mirrored path plus the
+                                 1. The path beyond each end is the mirrored path plus the
                                  share 1 - ease of its trend, so the end frames are smoothed
                                  over a full window; no effect when causal */
     int downscale;            /* register on luma box-averaged by 1, 2 or 4 */
@@ -172,7 +172,7 @@ typedef struct home_stab_output {
 
 typedef struct home_stab home_stab;
 
-/* Defaults for a width x height stream: margins 0.10, automatic smoothing, lookahead 0, ease 0.6,
+/* Defaults for a width x height stream: margins 0.10, automatic smoothing, lookahead 0, ease 1,
  * downscale 2 for frames wider than 960 px (else 1), then home_video_config()'s choices for the
  * registration image (500 keypoints per sign; automatic hough_downscale: the 4x4-box copy where
  * that is at least 96 px wide, else home_video_config's) with 88 theta bins, a theta window from

@@ -74,8 +74,9 @@ int home_stab_default_config(home_stab_config *cfg, int width, int height)
     cfg->margin_x = cfg->margin_y = 0.10f;
     cfg->smoothing = 0.0f;   /* automatic: see home_stab_config */
     cfg->lookahead = 0;
-    /* the ends ease out of about half the pan (docs/presets.md: the ITF / jitter trade) */
-    cfg->ease = 0.6f;
+    /* the virtual camera starts from and comes to rest at the ends (docs/presets.md: the ITF /
+     * jitter trade) */
+    cfg->ease = 1.0f;
     /* registration at full size up to 960 px wide: half size costs textureless clips jitter */
     cfg->downscale = width > 960 ? 2 : 1;
     cfg->min_inliers = 20;
