@@ -310,6 +310,12 @@ typedef struct home_result {
  * Model and accuracy: each fit (lines, then photometric) chooses the simplest model up to
  * cfg.max_model that its data support (BIC over the fit's Fisher information) and predicts the
  * RMS corner error sigma_px from its covariance. ok requires sigma_px <= cfg.max_sigma_px.
+ * Where a few long edges leave the refinement's model undetermined, a simpler one stands in
+ * from the same start if it is sharply fixed: a similarity for a homography (HOME's estimate
+ * not ok), then a rigid motion (rotation and translation, unit scale) for a similarity whose
+ * scale the edges leave free (they meet near one point; under a similarity cap also beside an
+ * ok line fit). A rigid answer is reported as a similarity, its sigma_px holding 0.3 px for
+ * the scale change between the frames it leaves out.
  *
  * Failure rule with refinement: HOME's estimate (ok, or short of inliers or certainty with at
  * least 8 inliers) is refined. An accepted refinement within max(refine_trust_px, 3 sigma_px)

@@ -312,12 +312,15 @@ void home__cholesky_solve8(const double *l, double *b);
 /* model.c: motion-model selection over a fit's Fisher information (see there) */
 #define HOME__SPACE_H 0          /* parameters: the homography's entries h0..h7 */
 #define HOME__SPACE_G 1          /* parameters: those of G = H^-T (the line fit's) */
+#define HOME__MODEL_RIGID (HOME_MODEL_HOMOGRAPHY + 1) /* internal: a similarity whose scale is
+                                                     held (rotation and translation) */
 typedef struct home__model_problem {
     int space;                   /* HOME__SPACE_H or _G */
     double p[8];                 /* the estimate, normalised coordinates */
     double info[64];             /* its Fisher information (inverse covariance) */
     double penalty;              /* per parameter, in units of the information's chi-square */
     int max_model;               /* enum home_model: the caller's cap */
+    int rigid;                   /* 1: the similarity's scale is held (HOME__MODEL_RIGID) */
     int max_params;              /* models with more parameters are not determined by the data */
     double scale, cx, cy;        /* pixel = scale * normalised + (cx, cy) */
     double floor_px;             /* > 0: the choice weighs each model's misfit as if every

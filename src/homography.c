@@ -151,6 +151,7 @@ static void choose_model(home_context *ctx, home__line_problem *lp, int n_in, do
     for (k = 0; k < 64; k++) mp.info[k] = jtj[k] / var;
     mp.penalty = log(2.0 * (distinct > 0 ? distinct : 1));
     mp.max_model = ctx->cfg.max_model;
+    mp.rigid = 0;
     mp.max_params = distinct; /* each line fixes two parameters: twice what a model needs */
     mp.scale = lp->scale;
     mp.cx = 0.5 * (ctx->cfg.width - 1);

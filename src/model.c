@@ -63,6 +63,14 @@ int home__model_basis(int space, int model, double *o, double basis[8][8])
         basis[k++][tx] = 1.0;
         basis[k++][ty] = 1.0;
         break;
+    case HOME__MODEL_RIGID:
+        o[0] = o[4] = 1.0;
+        basis[k][1] = -1.0;
+        basis[k][3] = 1.0;
+        k++;
+        basis[k++][tx] = 1.0;
+        basis[k++][ty] = 1.0;
+        break;
     case HOME_MODEL_SIMILARITY:
         basis[k][0] = basis[k][4] = 1.0;
         k++;
@@ -266,6 +274,12 @@ static double quadratic8(const double *d, const double *m)
     return v;
 }
 
+/* The basis a model stands for in this problem: a rigid motion in the similarity's place. */
+static int basis_model(const home__model_problem *mp, int model)
+{
+    return mp->rigid && model == HOME_MODEL_SIMILARITY ? HOME__MODEL_RIGID : model;
+}
+
 int home__select_model(const home__model_problem *mp, home__model_choice *out)
 {
     enum { MODELS = HOME_MODEL_HOMOGRAPHY + 1 };
@@ -282,7 +296,7 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
               mp->max_model == HOME_MODEL_HOMOGRAPHY && floored_information(mp, weigh);
     for (model = HOME_MODEL_IDENTITY; model <= mp->max_model; model++) {
         double q[8], diff[8], a_copy[64];
-        const int k = home__model_basis(mp->space, model, o, basis);
+        const int k = home__model_basis(mp->space, basis_model(mp, model), o, basis);
         k_of[model] = -1; /* not determined by the data */
         if (k > mp->max_params) break;
         /* q = (B^T F B)^-1 B^T F (p - o) */
@@ -327,7 +341,7 @@ int home__select_model(const home__model_problem *mp, home__model_choice *out)
     if (best < HOME_MODEL_HOMOGRAPHY && mp->max_model == HOME_MODEL_HOMOGRAPHY &&
         !(out->delta <= mp->penalty * (8 - k_of[best])))
         return 0;
-    (void)home__model_basis(mp->space, best, o, basis);
+    (void)home__model_basis(mp->space, basis_model(mp, best), o, basis);
     projected_normal(mp, (const double (*)[8])basis, k_of[best], o, n_mat, rhs);
     out->sigma_px = model_sigma(mp, (const double (*)[8])basis, k_of[best], n_mat, out->p);
     if (!isfinite(out->sigma_px)) return 0;

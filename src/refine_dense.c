@@ -493,6 +493,7 @@ static int choose(const dense_solver *s, const double *infoq, double basis[8][8]
     }
     mp.penalty = log((double)n);
     mp.max_model = s->ctx->cfg.max_model;
+    mp.rigid = 0;
     mp.max_params = s->k;
     mp.scale = s->f;
     mp.cx = s->cx;

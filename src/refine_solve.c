@@ -33,6 +33,11 @@
                                    the frames' (not the template's gradient noise): only sharp
                                    edges pin a similarity; faint content, dim or shaded, leaves
                                    it at a biased optimum (docs/trust.md, session 33) */
+#define STAND_IN_RIGID 2   /* refine_model()'s stand_in: a rigid motion (1: a similarity) */
+#define RIGID_SCALE_PX 0.3 /* a rigid motion standing in for a similarity whose scale the frames do
+                              not fix: the scale change it leaves out, px at the corners (the
+                              evaluation's cameras: 0.18 px between frames in the median, 0.43 at
+                              most; docs/trust.md, session 38) */
 #define SPARSE_END_SIGMA 1.6 /* a stand-in ending at a level with fewer than FINEST_MIN_POINTS
                                 points predicts its error times this (tuning frames: its errors
                                 were 0.8 of the predicted in the median against 0.5 for the
@@ -696,7 +701,8 @@ static int update_between(const double *hn, const double *hn2, double *dp)
  * rule through dp(h) (central differences) gives that of h's entries. A homography must also
  * stand out of MODEL_FLOOR_PX. h1 (pixels) becomes the chosen model's estimate; sets
  * result->model and sigma_px. */
-static int choose_model(home__refine_solver *s, int max_model, double *h1, home_result *result)
+static int choose_model(home__refine_solver *s, int max_model, int rigid, double *h1,
+                        home_result *result)
 {
     home__model_problem mp;
     home__model_choice choice;
@@ -728,6 +734,7 @@ static int choose_model(home__refine_solver *s, int max_model, double *h1, home_
     memcpy(mp.p, s->hn, sizeof mp.p);
     mp.penalty = log((double)s->tpl[s->finest].n);
     mp.max_model = max_model;
+    mp.rigid = rigid;
     mp.max_params = 8;
     mp.scale = s->f;
     mp.cx = s->cx;
@@ -872,10 +879,11 @@ static int run_level(home__refine_solver *s, int level, int max_iterations, int 
 
 /* Refine h (A -> B pixels) with the template of slot `slot` against the stored pyramid,
  * without the points of the excluded regions (NULL: none), on a probe's leash (NULL: none),
- * with a lens falloff fitted beside the motion when shading is set; stand_in: a similarity
- * standing in for an undetermined homography, refused outside the STAND_IN_ limits, its sigma
- * holding the perspective it leaves out. Writes the refined H and fills the refine fields of
- * result. */
+ * with a lens falloff fitted beside the motion when shading is set; stand_in: 1, a similarity
+ * standing in for an undetermined homography, or STAND_IN_RIGID, a rigid motion for a similarity
+ * (from the start's rotation and centre at unit scale), refused outside the STAND_IN_ limits, its
+ * sigma holding the motion it leaves out (a rigid one's also RIGID_SCALE_PX). Writes the refined
+ * H and fills the refine fields of result. */
 static double refine_model(home_context *ctx, int slot, const double *h0,
                            const unsigned char *excluded, const probe_leash *leash, int patient,
                            int shading, int max_model, int stand_in, home_result *result)
@@ -895,7 +903,9 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     s.k = 8;
     if (max_model < HOME_MODEL_HOMOGRAPHY) {
         double o[8];
-        s.k = home__model_basis(HOME__SPACE_H, max_model, o, s.basis);
+        s.k = home__model_basis(HOME__SPACE_H,
+                                stand_in == STAND_IN_RIGID ? HOME__MODEL_RIGID : max_model, o,
+                                s.basis);
     }
     /* a few sharp edges at half size (the video preset's finest level) fill fewer points than
      * FINEST_MIN_POINTS asks of faint texture; a quarter of the level's capacity lets a
@@ -914,6 +924,19 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
         return 0.0;
     }
     home__refine_to_normalised(&s, h0, hn0);
+    if (stand_in == STAND_IN_RIGID) {
+        /* the rigid motion nearest the start: its rotation and its centre's motion, unit scale */
+        const double det = hn0[0] * hn0[4] - hn0[1] * hn0[3];
+        if (!(det > 0.0)) {
+            result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+            return 0.0;
+        }
+        for (k = 0; k < 9; k++) hn0[k] /= hn0[8];
+        hn0[0] = hn0[4] = 0.5 * (hn0[0] + hn0[4]) / sqrt(det);
+        hn0[3] = 0.5 * (hn0[3] - hn0[1]) / sqrt(det);
+        hn0[1] = -hn0[3];
+        hn0[6] = hn0[7] = 0.0;
+    }
     memcpy(s.hn, hn0, sizeof hn0);
     for (level = s.finest; level < st->levels; level++) {
         if (s.tpl[level].n < MIN_POINTS) {
@@ -974,14 +997,15 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
         result->refine_status = HOME_REFINE_NOT_LOWER;
         return 0.0;
     }
-    if (!choose_model(&s, max_model, h1, result) ||
+    if (!choose_model(&s, max_model, stand_in == STAND_IN_RIGID, h1, result) ||
         (stand_in && !(misfit <= STAND_IN_MAX_MISFIT_PX &&
                        result->sigma_px <= STAND_IN_MAX_SIGMA_PX && signal >= STAND_IN_MIN_SIGNAL))) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0.0;
     }
-    /* a stand-in's error holds the perspective it leaves out */
-    result->sigma_px = sqrt(result->sigma_px * result->sigma_px + misfit * misfit);
+    /* a stand-in's error holds the perspective it leaves out, a rigid one's also the scale */
+    result->sigma_px = sqrt(result->sigma_px * result->sigma_px + misfit * misfit +
+                            (stand_in == STAND_IN_RIGID ? RIGID_SCALE_PX * RIGID_SCALE_PX : 0.0));
     if (sparse_end) result->sigma_px *= SPARSE_END_SIGMA;
     memcpy(result->H, h1, sizeof h1);
     result->refined = 1;
@@ -993,20 +1017,32 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
  * frames do not determine (a few long edges: ill conditioned, or sliding without converging)
  * and HOME's estimate is not ok (an ok line fit's homography stands), a similarity stands in
  * for it from the same start, if the perspective it leaves out is small
- * (stand_in_misfit_px()). */
+ * (stand_in_misfit_px()); where that is refused, or under a similarity cap the similarity is
+ * not determined (edges through nearly one point leave its scale free), a rigid motion. */
 double home__refine_run(home_context *ctx, int slot, const double *h0, int patient,
                         int may_stand_in, home_result *result)
 {
     const home_result start = *result;
     const double apart = refine_model(ctx, slot, h0, NULL, NULL, patient, 0,
                                       ctx->cfg.max_model, 0, result);
+    int stand_in;
     ctx->refine.stood_in = 0;
-    if (may_stand_in && ctx->cfg.max_model == HOME_MODEL_HOMOGRAPHY && !start.ok &&
-        (result->refine_status == HOME_REFINE_ILL_CONDITIONED ||
-         result->refine_status == HOME_REFINE_NOT_CONVERGED)) {
+    /* (an ok line fit's homography stands; a similarity it fixes may still need the stand-in
+     * where its scale rests on the noise) */
+    if (!may_stand_in || (start.ok && ctx->cfg.max_model == HOME_MODEL_HOMOGRAPHY) ||
+        (ctx->cfg.max_model != HOME_MODEL_HOMOGRAPHY &&
+         ctx->cfg.max_model != HOME_MODEL_SIMILARITY))
+        return apart;
+    /* a similarity for a homography, then a rigid motion for a similarity whose scale the
+     * edges leave free (they meet near one point: docs/trust.md, session 38) */
+    for (stand_in = ctx->cfg.max_model == HOME_MODEL_HOMOGRAPHY ? 1 : STAND_IN_RIGID;
+         stand_in <= STAND_IN_RIGID && (result->refine_status == HOME_REFINE_ILL_CONDITIONED ||
+                                        result->refine_status == HOME_REFINE_NOT_CONVERGED);
+         stand_in++) {
         home_result capped = start;
         capped.refined = 0;
-        refine_model(ctx, slot, h0, NULL, NULL, patient, 0, HOME_MODEL_SIMILARITY, 1, &capped);
+        refine_model(ctx, slot, h0, NULL, NULL, patient, 0, HOME_MODEL_SIMILARITY, stand_in,
+                     &capped);
         if (capped.refined) {
             *result = capped;
             ctx->refine.stood_in = 1;
