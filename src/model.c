@@ -63,17 +63,12 @@ int home__model_basis(int space, int model, double *o, double basis[8][8])
         basis[k++][tx] = 1.0;
         basis[k++][ty] = 1.0;
         break;
-    case HOME__MODEL_RIGID:
-        o[0] = o[4] = 1.0;
-        basis[k][1] = -1.0;
-        basis[k][3] = 1.0;
-        k++;
-        basis[k++][tx] = 1.0;
-        basis[k++][ty] = 1.0;
-        break;
     case HOME_MODEL_SIMILARITY:
         basis[k][0] = basis[k][4] = 1.0;
-        k++;
+        k++; /* a scale, and a rigid motion's parameters: */
+        /* fall through */
+    case HOME__MODEL_RIGID:
+        if (model == HOME__MODEL_RIGID) o[0] = o[4] = 1.0;
         basis[k][1] = -1.0;
         basis[k][3] = 1.0;
         k++;
