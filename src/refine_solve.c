@@ -42,6 +42,14 @@
                                 points predicts its error times this (tuning frames: its errors
                                 were 0.8 of the predicted in the median against 0.5 for the
                                 rest, one scene biased 0.3 px along two parallel edges) */
+#define RIGID_SPARSE_POINTS 128 /* a rigid stand-in may end at the finest level with this many
+                                   points (a few dim edges fill 200-500 of its 4096 at full
+                                   size; a similarity stand-in needs a quarter of them) */
+#define CAPPED_MIN_SIGNAL 0.62 /* a model capped below the homography (the stabiliser's) needs
+                                  this share of its translation's information to be the
+                                  frames': fog, dim gradients and smooth blobs reach optima
+                                  2-8 px off at a share of 0.50-0.61 (docs/trust.md, session
+                                  39) */
 #define SLOW_ITERATIONS 4    /* a finest level still shrinking its steps may take this many
                                 times the iteration cap */
 #define SIGNAL_SHARE_MIN 0.05 /* ... the information kept then, at least this share */
@@ -910,9 +918,12 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     /* a few sharp edges at half size (the video preset's finest level) fill fewer points than
      * FINEST_MIN_POINTS asks of faint texture; a quarter of the level's capacity lets a
      * stand-in end there (fog and dim gradients fill less, the signal share refuses the rest),
-     * with a larger predicted error */
+     * with a larger predicted error; a rigid motion's three parameters, fewer points (a few
+     * dim edges at full size) */
     if (stand_in && s.finest != st->finest_level &&
-        s.tpl[st->finest_level].n >= s.tpl[st->finest_level].capacity / 4) {
+        s.tpl[st->finest_level].n >= (stand_in == STAND_IN_RIGID
+                                          ? RIGID_SPARSE_POINTS
+                                          : s.tpl[st->finest_level].capacity / 4)) {
         s.finest = st->finest_level;
         sparse_end = 1;
     }
@@ -999,14 +1010,17 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     }
     if (!choose_model(&s, max_model, stand_in == STAND_IN_RIGID, h1, result) ||
         (stand_in && !(misfit <= STAND_IN_MAX_MISFIT_PX &&
-                       result->sigma_px <= STAND_IN_MAX_SIGMA_PX && signal >= STAND_IN_MIN_SIGNAL))) {
+                       result->sigma_px <= STAND_IN_MAX_SIGMA_PX && signal >= STAND_IN_MIN_SIGNAL)) ||
+        (!stand_in && max_model < HOME_MODEL_HOMOGRAPHY && signal < CAPPED_MIN_SIGNAL)) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0.0;
     }
-    /* a stand-in's error holds the perspective it leaves out, a rigid one's also the scale */
-    result->sigma_px = sqrt(result->sigma_px * result->sigma_px + misfit * misfit +
-                            (stand_in == STAND_IN_RIGID ? RIGID_SCALE_PX * RIGID_SCALE_PX : 0.0));
+    /* a stand-in's error holds the perspective it leaves out (at a sparse level, both as
+     * measured there), a rigid one's also the scale it holds (a prior, not a measurement) */
+    result->sigma_px = sqrt(result->sigma_px * result->sigma_px + misfit * misfit);
     if (sparse_end) result->sigma_px *= SPARSE_END_SIGMA;
+    if (stand_in == STAND_IN_RIGID)
+        result->sigma_px = hypot(result->sigma_px, RIGID_SCALE_PX);
     memcpy(result->H, h1, sizeof h1);
     result->refined = 1;
     result->refine_status = HOME_REFINE_ACCEPTED;
