@@ -43,8 +43,8 @@
                                 were 0.8 of the predicted in the median against 0.5 for the
                                 rest, one scene biased 0.3 px along two parallel edges) */
 #define RIGID_SPARSE_POINTS 128 /* a rigid stand-in may end at the finest level with this many
-                                   points (a few dim edges fill 200-500 of its 4096 at full
-                                   size; a similarity stand-in needs a quarter of them) */
+                                   points (a few edges fill 240-510 of its 4096 at full size,
+                                   dim or by day; a similarity stand-in needs a quarter) */
 #define CAPPED_MIN_SIGNAL 0.62 /* a model capped below the homography (the stabiliser's) needs
                                   this share of its translation's information to be the
                                   frames': fog, dim gradients and smooth blobs reach optima
@@ -890,8 +890,9 @@ static int run_level(home__refine_solver *s, int level, int max_iterations, int 
  * with a lens falloff fitted beside the motion when shading is set; stand_in: 1, a similarity
  * standing in for an undetermined homography, or STAND_IN_RIGID, a rigid motion for a similarity
  * (from the start's rotation and centre at unit scale), refused outside the STAND_IN_ limits, its
- * sigma holding the motion it leaves out (a rigid one's also RIGID_SCALE_PX). Writes the refined
- * H and fills the refine fields of result. */
+ * sigma holding the motion it leaves out (a rigid one's also RIGID_SCALE_PX); a model capped
+ * below the homography, refused below CAPPED_MIN_SIGNAL. Writes the refined H and fills the
+ * refine fields of result. */
 static double refine_model(home_context *ctx, int slot, const double *h0,
                            const unsigned char *excluded, const probe_leash *leash, int patient,
                            int shading, int max_model, int stand_in, home_result *result)
@@ -1008,10 +1009,14 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
         result->refine_status = HOME_REFINE_NOT_LOWER;
         return 0.0;
     }
+    if (!stand_in && max_model < HOME_MODEL_HOMOGRAPHY && signal < CAPPED_MIN_SIGNAL) {
+        /* (before choose_model(), which writes the result's model and sigma) */
+        result->refine_status = HOME_REFINE_ILL_CONDITIONED;
+        return 0.0;
+    }
     if (!choose_model(&s, max_model, stand_in == STAND_IN_RIGID, h1, result) ||
         (stand_in && !(misfit <= STAND_IN_MAX_MISFIT_PX &&
-                       result->sigma_px <= STAND_IN_MAX_SIGMA_PX && signal >= STAND_IN_MIN_SIGNAL)) ||
-        (!stand_in && max_model < HOME_MODEL_HOMOGRAPHY && signal < CAPPED_MIN_SIGNAL)) {
+                       result->sigma_px <= STAND_IN_MAX_SIGMA_PX && signal >= STAND_IN_MIN_SIGNAL))) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0.0;
     }
