@@ -801,6 +801,25 @@ void test_capped_few_edges_dim_calibrated(void)
     CHECK(misses <= 4);
 }
 
+/* One registration under known motion h: counts the ok answers and the rigid ones among them
+ * (unit scale: a rigid motion's diagonal is exactly 1); every ok answer lies within 2 px and 3
+ * predicted errors. */
+static void check_rigid_test_answer(int frame, const home_result *res, const double *h, int *ok,
+                                    int *rigid)
+{
+    const double err = synth_corner_error(res->H, h, IMG_W, IMG_H);
+    if (!res->ok) return;
+    ++*ok;
+    *rigid += res->model == HOME_MODEL_SIMILARITY && fabs(res->H[0] - 1.0) < 1e-9 &&
+              fabs(res->H[4] - 1.0) < 1e-9;
+    if (err > 2.0 || err > 3.0 * res->sigma_px)
+        printf("     frame %3d: %s, %s, %d inliers, error %.3f px, sigma %.3f px\n", frame,
+               home_model_name(res->model), home_refine_status_name(res->refine_status),
+               res->inliers, err, res->sigma_px);
+    CHECK_LT(err, 2.0);
+    CHECK_LT(err, 3.0 * res->sigma_px);
+}
+
 /* Frame of a fan: 3-5 long edges (steps of 15-45 grey levels, 0.7 px blur) through nearly one
  * point of the frame (within 6 px of it), on a faint gradient, seen through h, noise 2.5. */
 static void render_fan(synth_rng *scene, const double *h, uint64_t seed, uint8_t *out)
@@ -854,7 +873,7 @@ void test_capped_few_edges_day_rigid(void)
     for (k = 0; k < 240; k += 4) {
         synth_rng rng, scene;
         home_result res;
-        double h[9], err, angle, scale, tx, ty;
+        double h[9], angle, scale, tx, ty;
         synth_seed(&scene, 4000 + (uint64_t)(k / 8));
         synth_seed(&rng, 4300 + (uint64_t)k);
         tx = 1.0 + 3.0 * synth_uniform(&rng);
@@ -865,17 +884,7 @@ void test_capped_few_edges_day_rigid(void)
         render_fan(&scene, identity, 4400 + 2 * (uint64_t)k, img_a);
         render_fan(&scene, h, 4401 + 2 * (uint64_t)k, img_b);
         CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
-        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
-        if (!res.ok) continue;
-        ok++;
-        /* a rigid answer: unit scale (the rigid model's diagonal is exactly 1) */
-        rigid += res.model == HOME_MODEL_SIMILARITY && fabs(res.H[0] - 1.0) < 1e-9 &&
-                 fabs(res.H[4] - 1.0) < 1e-9;
-        if (err > 2.0 || err > 3.0 * res.sigma_px)
-            printf("     frame %3d: %s, %d inliers, error %.3f px, sigma %.3f px\n", k,
-                   home_model_name(res.model), res.inliers, err, res.sigma_px);
-        CHECK_LT(err, 2.0);
-        CHECK_LT(err, 3.0 * res.sigma_px);
+        check_rigid_test_answer(k, &res, h, &ok, &rigid);
     }
     printf("     %d of 60 ok, %d of them rigid\n", ok, rigid);
     CHECK(ok >= 40);
@@ -896,7 +905,7 @@ void test_few_edges_dim_rigid_sparse(void)
     for (k = 0; k < 240; k += 4) {
         synth_rng rng, scene;
         home_result res;
-        double h[9], err, gain, angle, scale, tx, ty;
+        double h[9], gain, angle, scale, tx, ty;
         synth_seed(&scene, 4000 + (uint64_t)(k / 8));
         synth_seed(&rng, 4500 + (uint64_t)k);
         tx = 1.0 + 3.0 * synth_uniform(&rng);
@@ -908,17 +917,7 @@ void test_few_edges_dim_rigid_sparse(void)
         render_few_edges_dim(&scene, identity, gain, 4600 + 2 * (uint64_t)k, img_a);
         render_few_edges_dim(&scene, h, gain, 4601 + 2 * (uint64_t)k, img_b);
         CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
-        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
-        if (!res.ok) continue;
-        ok++;
-        rigid += res.model == HOME_MODEL_SIMILARITY && fabs(res.H[0] - 1.0) < 1e-9 &&
-                 fabs(res.H[4] - 1.0) < 1e-9;
-        if (err > 2.0 || err > 3.0 * res.sigma_px)
-            printf("     frame %3d: %s, %s, %d inliers, error %.3f px, sigma %.3f px\n", k,
-                   home_model_name(res.model), home_refine_status_name(res.refine_status),
-                   res.inliers, err, res.sigma_px);
-        CHECK_LT(err, 2.0);
-        CHECK_LT(err, 3.0 * res.sigma_px);
+        check_rigid_test_answer(k, &res, h, &ok, &rigid);
     }
     printf("     %d of 60 ok, %d of them rigid\n", ok, rigid);
     CHECK(rigid >= 1); /* the case this is about */
@@ -966,7 +965,7 @@ void test_capped_fog_horizon_calibrated(void)
 {
     home_config cfg;
     home_context *ctx;
-    int k, ok = 0;
+    int k, ok = 0, rigid = 0;
     home_default_config(&cfg, IMG_W, IMG_H);
     cfg.max_model = HOME_MODEL_SIMILARITY;
     ctx = context(&cfg);
@@ -974,7 +973,7 @@ void test_capped_fog_horizon_calibrated(void)
     for (k = 0; k < 120; k += 4) {
         synth_rng rng, scene;
         home_result res;
-        double h[9], err, angle, tx, ty;
+        double h[9], angle, tx, ty;
         synth_seed(&scene, 4700 + (uint64_t)(k / 8));
         synth_seed(&rng, 4800 + (uint64_t)k);
         tx = 1.0 + 3.0 * synth_uniform(&rng);
@@ -984,16 +983,9 @@ void test_capped_fog_horizon_calibrated(void)
         render_fog_horizon(&scene, identity, 4900 + 2 * (uint64_t)k, img_a);
         render_fog_horizon(&scene, h, 4901 + 2 * (uint64_t)k, img_b);
         CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
-        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
-        if (!res.ok) continue;
-        ok++;
-        printf("     frame %3d: %s, %s, %d inliers, error %.3f px, sigma %.3f px\n", k,
-               home_model_name(res.model), home_refine_status_name(res.refine_status),
-               res.inliers, err, res.sigma_px);
-        CHECK_LT(err, 2.0);
-        CHECK_LT(err, 3.0 * res.sigma_px);
+        check_rigid_test_answer(k, &res, h, &ok, &rigid);
     }
-    printf("     %d of 30 ok\n", ok);
+    printf("     %d of 30 ok, %d of them rigid\n", ok, rigid);
 }
 
 /* Lens shading: a falloff towards the corners of 15-40 %, fixed to the sensor, on frames A and
