@@ -135,6 +135,10 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, int patie
  * motion the frame's pixels give where a capped model misfits them. */
 void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
                                  home_result *result);
+/* The similarity reached from the rigid motion's optimum nearest h0 (both refined patiently;
+ * result->refined 0 when either fails): another path to a capped similarity's optimum. */
+void home__refine_run_through_rigid(home_context *ctx, int slot, const double *h0,
+                                    home_result *result);
 /* The same (patient) up to max_model, fitting beside the motion a lens falloff fixed to the
  * sensor, s = 1 - kappa rho^2 (rho^2 = 1 at the corners): frames whose background shows one,
  * or a similarity standing in (stand_in: home__refine_run()'s conditions on it). */

@@ -34,6 +34,8 @@
                                    edges pin a similarity; faint content, dim or shaded, leaves
                                    it at a biased optimum (docs/trust.md, session 33) */
 #define STAND_IN_RIGID 2   /* refine_model()'s stand_in: a rigid motion (1: a similarity) */
+#define RIGID_START 3      /* ... or a rigid motion only as a similarity's start, without a
+                              stand-in's limits (home__refine_run_through_rigid()) */
 #define RIGID_SCALE_PX 0.3 /* a rigid motion standing in for a similarity whose scale the frames do
                               not fix: the scale change it leaves out, px at the corners (the
                               evaluation's cameras: 0.18 px between frames in the median, 0.43 at
@@ -890,7 +892,8 @@ static int run_level(home__refine_solver *s, int level, int max_iterations, int 
  * with a lens falloff fitted beside the motion when shading is set; stand_in: 1, a similarity
  * standing in for an undetermined homography, or STAND_IN_RIGID, a rigid motion for a similarity
  * (from the start's rotation and centre at unit scale), refused outside the STAND_IN_ limits, its
- * sigma holding the motion it leaves out (a rigid one's also RIGID_SCALE_PX); a model capped
+ * sigma holding the motion it leaves out (a rigid one's also RIGID_SCALE_PX), or RIGID_START,
+ * that rigid motion without the limits; a model capped
  * below the homography, refused below CAPPED_MIN_SIGNAL. Writes the refined H and fills the
  * refine fields of result. */
 static double refine_model(home_context *ctx, int slot, const double *h0,
@@ -901,6 +904,7 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     home__refine_solver s;
     double hn0[9], h1[9], e0, e1, zncc0, zncc1, refined_std, misfit = 0.0, signal;
     int level, k, converged = 0, iterations = 0, sparse_end = 0;
+    const int rigid = stand_in == STAND_IN_RIGID || stand_in == RIGID_START;
     const double max_std =
         MAX_CORNER_STD_PX > ctx->cfg.max_sigma_px ? MAX_CORNER_STD_PX : ctx->cfg.max_sigma_px;
 
@@ -913,7 +917,7 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
     if (max_model < HOME_MODEL_HOMOGRAPHY) {
         double o[8];
         s.k = home__model_basis(HOME__SPACE_H,
-                                stand_in == STAND_IN_RIGID ? HOME__MODEL_RIGID : max_model, o,
+                                rigid ? HOME__MODEL_RIGID : max_model, o,
                                 s.basis);
     }
     /* a few sharp edges at half size (the video preset's finest level) fill fewer points than
@@ -922,8 +926,7 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
      * with a larger predicted error; a rigid motion's three parameters, fewer points (a few
      * dim edges at full size) */
     if (stand_in && s.finest != st->finest_level &&
-        s.tpl[st->finest_level].n >= (stand_in == STAND_IN_RIGID
-                                          ? RIGID_SPARSE_POINTS
+        s.tpl[st->finest_level].n >= (rigid ? RIGID_SPARSE_POINTS
                                           : s.tpl[st->finest_level].capacity / 4)) {
         s.finest = st->finest_level;
         sparse_end = 1;
@@ -936,7 +939,7 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
         return 0.0;
     }
     home__refine_to_normalised(&s, h0, hn0);
-    if (stand_in == STAND_IN_RIGID) {
+    if (rigid) {
         /* the rigid motion nearest the start: its rotation and its centre's motion, unit scale */
         const double det = hn0[0] * hn0[4] - hn0[1] * hn0[3];
         if (!(det > 0.0)) {
@@ -1014,8 +1017,8 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0.0;
     }
-    if (!choose_model(&s, max_model, stand_in == STAND_IN_RIGID, h1, result) ||
-        (stand_in && !(misfit <= STAND_IN_MAX_MISFIT_PX &&
+    if (!choose_model(&s, max_model, rigid, h1, result) ||
+        (stand_in && stand_in != RIGID_START && !(misfit <= STAND_IN_MAX_MISFIT_PX &&
                        result->sigma_px <= STAND_IN_MAX_SIGMA_PX && signal >= STAND_IN_MIN_SIGNAL))) {
         result->refine_status = HOME_REFINE_ILL_CONDITIONED;
         return 0.0;
@@ -1024,7 +1027,7 @@ static double refine_model(home_context *ctx, int slot, const double *h0,
      * measured there), a rigid one's also the scale it holds (a prior, not a measurement) */
     result->sigma_px = sqrt(result->sigma_px * result->sigma_px + misfit * misfit);
     if (sparse_end) result->sigma_px *= SPARSE_END_SIGMA;
-    if (stand_in == STAND_IN_RIGID)
+    if (rigid)
         result->sigma_px = hypot(result->sigma_px, RIGID_SCALE_PX);
     memcpy(result->H, h1, sizeof h1);
     result->refined = 1;
@@ -1200,6 +1203,25 @@ void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
                                  home_result *result)
 {
     refine_model(ctx, slot, h0, NULL, NULL, 0, 0, HOME_MODEL_HOMOGRAPHY, 0, result);
+}
+
+/* The similarity reached from the rigid motion's optimum nearest h0, both refined patiently
+ * (result->refined 0 when either fails; the rigid optimum where the similarity does not lower
+ * its error). Where a similarity's scale is not determined (a horizon in fog: scale and
+ * translation trade along a valley), the optimum depends on the path to it, and one reached
+ * from HOME's estimate directly may lie 5-10 px from this one. */
+void home__refine_run_through_rigid(home_context *ctx, int slot, const double *h0,
+                                    home_result *result)
+{
+    const home_result start = *result;
+    home_result rigid;
+    refine_model(ctx, slot, h0, NULL, NULL, 1, 0, HOME_MODEL_SIMILARITY, RIGID_START, result);
+    if (!result->refined) return;
+    rigid = *result;
+    *result = start;
+    result->refined = 0;
+    refine_model(ctx, slot, rigid.H, NULL, NULL, 1, 0, HOME_MODEL_SIMILARITY, 0, result);
+    if (result->refine_status == HOME_REFINE_NOT_LOWER) *result = rigid;
 }
 
 void home__refine_run_shaded(home_context *ctx, int slot, const double *h0, int max_model,

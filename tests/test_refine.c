@@ -988,6 +988,106 @@ void test_capped_fog_horizon_calibrated(void)
     printf("     %d of 30 ok, %d of them rigid\n", ok, rigid);
 }
 
+/* A sea horizon in haze: a sky brightening upwards over a sea of faint swell bands (1-2 grey
+ * levels), low hills along the horizon and a soft sun glow, seen through h, noise 2. */
+static void render_hazy_sea(synth_rng *scene, const double *h, uint64_t seed, uint8_t *out)
+{
+    double amp[3], freq[3], phase[3], haze, horizon, tilt, sky, sea, swell, period, hill_depth,
+        glow, gx, gy, inv[9];
+    int i, x, y;
+    synth_rng rng = *scene;
+    synth_rng noise;
+    haze = 140.0 + 50.0 * synth_uniform(&rng);
+    horizon = (0.45 + 0.15 * synth_uniform(&rng)) * IMG_H;
+    tilt = 0.06 * (synth_uniform(&rng) - 0.5);
+    sky = 10.0 + 20.0 * synth_uniform(&rng);
+    sea = 8.0 + 12.0 * synth_uniform(&rng);
+    swell = 0.8 + 1.2 * synth_uniform(&rng);
+    period = 25.0 + 20.0 * synth_uniform(&rng);
+    hill_depth = 5.0 + 7.0 * synth_uniform(&rng);
+    glow = 10.0 + 15.0 * synth_uniform(&rng);
+    gx = (0.2 + 0.6 * synth_uniform(&rng)) * IMG_W;
+    gy = horizon - (0.1 + 0.2 * synth_uniform(&rng)) * IMG_H;
+    for (i = 0; i < 3; i++) {
+        amp[i] = (3.0 + 6.0 * synth_uniform(&rng)) / (i + 1);
+        freq[i] = 6.28318530717959 * (i + 1) * (0.7 + 0.6 * synth_uniform(&rng)) / IMG_W;
+        phase[i] = 6.28318530717959 * synth_uniform(&rng);
+    }
+    synth_invert(h, inv);
+    synth_seed(&noise, seed);
+    for (y = 0; y < IMG_H; y++)
+        for (x = 0; x < IMG_W; x++) {
+            double sx, sy, yh, hills = 15.0, below, v;
+            synth_apply(inv, x, y, &sx, &sy);
+            yh = sy - horizon - tilt * (sx - 0.5 * IMG_W);
+            for (i = 0; i < 3; i++) hills += amp[i] * sin(freq[i] * sx + phase[i]);
+            below = 0.5 * (1.0 + tanh(yh / 1.0));
+            v = haze + sky * (yh < 0.0 ? (-yh / IMG_H > 1.0 ? 1.0 : -yh / IMG_H) : 0.0);
+            v += below * (-sea - 0.05 * (yh > 0.0 ? yh : 0.0) - v + haze +
+                          swell * sin(6.28318530717959 * pow(yh > 0.0 ? yh : 0.0, 1.3) / period));
+            v -= hill_depth * 0.5 * (1.0 + tanh((yh + hills) / 2.0)) * (1.0 - below);
+            v += glow * exp(-((sx - gx) * (sx - gx) + (sy - gy) * (sy - gy)) /
+                            (2.0 * (0.15 * IMG_W) * (0.15 * IMG_W)));
+            v += 2.0 * synth_gauss(&noise);
+            out[y * IMG_W + x] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : floor(v + 0.5));
+        }
+}
+
+/* A sea horizon in haze with the stabiliser's registration settings (src/stabilise.c,
+ * home_config_for(): the video preset at 88 theta bins, a 4x4-box Hough image, 1024 refinement
+ * points ending at half size, up to 4 px of predicted error), the camera shaking 4-10 px between
+ * frames with a roll of up to 0.4 degrees. HOME finds a few lines (a translation, too few
+ * inliers), and from there a similarity may slide along the valley where scale and translation
+ * trade, to an optimum several px off at a predicted 0.5-1 px, where a path through the rigid
+ * motion ends elsewhere: its error is at least that distance (docs/trust.md, session 40). Of 120
+ * frames, 19 were ok, 7 of them 3.8-16.7 predicted errors off (up to 19 px); now 14, none beyond
+ * 4 predicted errors. Still open: 4 are 3.1-3.6 predicted errors off (1.4-3.8 px), biased along
+ * the horizon. */
+void test_capped_fog_rigid_path(void)
+{
+    home_config cfg;
+    home_context *ctx;
+    int k, ok = 0, beyond = 0, beyond4 = 0;
+    home_video_config(&cfg, IMG_W, IMG_H);
+    cfg.theta_bins = 88;
+    cfg.wrap_band = cfg.wrap_band * 88 / 120;
+    cfg.match_theta_window = 7;
+    cfg.hough_downscale = 4;
+    cfg.refine_points = 1024;
+    cfg.refine_finest_level = 1;
+    cfg.max_model = HOME_MODEL_SIMILARITY;
+    cfg.max_sigma_px = 4.0f;
+    ctx = context(&cfg);
+    if (!ctx) { CHECK(0); return; }
+    for (k = 0; k < 120; k++) {
+        synth_rng rng, scene;
+        home_result res;
+        double h[9], angle, tx, ty, err;
+        synth_seed(&scene, 5000 + (uint64_t)(k / 4));
+        synth_seed(&rng, 5100 + (uint64_t)k);
+        tx = (4.0 + 6.0 * synth_uniform(&rng)) * (synth_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+        ty = 6.0 * (synth_uniform(&rng) - 0.5);
+        angle = 0.014 * (synth_uniform(&rng) - 0.5);
+        similarity_about_centre(angle, 1.0, tx, ty, h);
+        render_hazy_sea(&scene, identity, 5200 + 2 * (uint64_t)k, img_a);
+        render_hazy_sea(&scene, h, 5201 + 2 * (uint64_t)k, img_b);
+        CHECK_EQ_INT(home_register(ctx, img_a, IMG_W, img_b, IMG_W, &res), HOME_OK);
+        if (!res.ok) continue;
+        ok++;
+        err = synth_corner_error(res.H, h, IMG_W, IMG_H);
+        beyond4 += err > 4.0 * res.sigma_px;
+        if (err > 3.0 * res.sigma_px) {
+            beyond++;
+            printf("     frame %2d: %s, %s, %d inliers, error %.3f px, sigma %.3f px\n", k,
+                   home_model_name(res.model), home_refine_status_name(res.refine_status),
+                   res.inliers, err, res.sigma_px);
+        }
+    }
+    printf("     %d of 120 ok, %d beyond 3 sigma, %d beyond 4\n", ok, beyond, beyond4);
+    CHECK_EQ_INT(beyond4, 0);
+    CHECK(ok >= 10);
+}
+
 /* Lens shading: a falloff towards the corners of 15-40 %, fixed to the sensor, on frames A and
  * B (the rest of the pixels as rendered), then camera noise 2. */
 static void shade_and_noise(uint8_t *im, double falloff, uint64_t seed)
@@ -1512,7 +1612,7 @@ void test_refine_bad_inputs(void)
 
 #define TEST_LIST(X) \
     X(kernels_match_references) X(arena_and_config) X(region_grid_exact) X(textured_subpixel) X(point_budget) X(finest_level_half) X(lines_subpixel) \
-    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) X(dense_lens_shading) X(lens_shading_pans_and_tripods) X(plain_test_fits_lens_falloff) X(few_edges_dim_calibrated) X(capped_few_edges_dim_calibrated) X(capped_few_edges_day_rigid) X(few_edges_dim_rigid_sparse) X(capped_fog_horizon_calibrated) \
+    X(moving_occluder) X(gain_change) X(textureless_declines) X(iteration_cap_keeps_start) X(low_light_converges) X(noisy_refinement_confirms) X(uncertain_lines_confirmed) X(dense_shading) X(dense_still_pairs) X(dense_dim_calibrated) X(dense_lens_shading) X(lens_shading_pans_and_tripods) X(plain_test_fits_lens_falloff) X(few_edges_dim_calibrated) X(capped_few_edges_dim_calibrated) X(capped_few_edges_day_rigid) X(few_edges_dim_rigid_sparse) X(capped_fog_horizon_calibrated) X(capped_fog_rigid_path) \
     X(trust_region) X(video_equals_pair) X(kept_snapshot) X(refinement_improves_home) X(failure_rule_rescue) \
     X(refine_bad_inputs)
 
