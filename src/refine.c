@@ -358,19 +358,25 @@ static double probe_spread(home_context *ctx, int slot, const home_result *refin
     return spread;
 }
 
-/* How far from refined's H (a similarity under the similarity cap) lies the optimum reached
- * through the rigid motion nearest h0, where it vouches for itself (INFINITY where that path
- * fails). A similarity whose scale the frames do not determine slides along a valley where
- * scale and translation trade: from HOME's uncertain estimate in fog to optima 5-12 px off at a
- * predicted 0.6-1 px, where the rigid path comes out elsewhere (docs/trust.md, session 40). */
-static double rigid_path_apart(home_context *ctx, int slot, const double *h0,
-                               const home_result *refined)
+/* A similarity under the similarity cap, refined from h0 where HOME cannot vouch for it (not
+ * stood in): its error is at least the distance to the optimum reached through the rigid motion
+ * nearest h0, and unknown where that path fails or does not vouch for itself. A similarity whose
+ * scale the frames do not determine slides along a valley where scale and translation trade:
+ * from HOME's uncertain estimate in fog to optima 5-12 px off at a predicted 0.6-1 px, where
+ * the rigid path comes out elsewhere (docs/trust.md, session 40). */
+static void widen_by_rigid_path(home_context *ctx, int slot, const double *h0, int stood_in,
+                                home_result *trial)
 {
-    home_result other = *refined;
+    home_result other = *trial;
+    double apart;
+    if (stood_in || trial->model != HOME_MODEL_SIMILARITY ||
+        ctx->cfg.max_model != HOME_MODEL_SIMILARITY)
+        return;
     other.refined = 0;
     home__refine_run_through_rigid(ctx, slot, h0, &other);
-    if (!other.refined || !vouches(ctx, &other, 0)) return INFINITY;
-    return corner_distance(ctx, other.H, refined->H);
+    apart = other.refined && vouches(ctx, &other, 0) ? corner_distance(ctx, other.H, trial->H)
+                                                     : INFINITY;
+    if (apart > trial->sigma_px) trial->sigma_px = apart;
 }
 
 /* Failure rule with the refinement (documented in home.h at home_match). */
@@ -412,12 +418,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
              * of the optima other starts reach (vouches() then holds it to the bound) */
             const double spread = probe_spread(ctx, slot, &trial, 1);
             if (spread > trial.sigma_px) trial.sigma_px = spread;
-            if (!stood_in && trial.model == HOME_MODEL_SIMILARITY &&
-                ctx->cfg.max_model == HOME_MODEL_SIMILARITY) {
-                const double apart_rigid =
-                    rigid_path_apart(ctx, slot, home__refine_identity, &trial);
-                if (apart_rigid > trial.sigma_px) trial.sigma_px = apart_rigid;
-            }
+            widen_by_rigid_path(ctx, slot, home__refine_identity, stood_in, &trial);
         }
         if (trial.refined && vouches(ctx, &trial, 1) && trial.model != HOME_MODEL_HOMOGRAPHY &&
             corner_distance(ctx, trial.H, home__refine_identity) <=
@@ -460,12 +461,7 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
                                 ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
                 const double spread = probe_spread(ctx, slot, &trial, stood_in);
                 if (spread > trial.sigma_px) trial.sigma_px = spread;
-                /* ... and, for a similarity, of the optimum reached through a rigid motion */
-                if (!stood_in && trial.model == HOME_MODEL_SIMILARITY &&
-                    ctx->cfg.max_model == HOME_MODEL_SIMILARITY) {
-                    const double apart_rigid = rigid_path_apart(ctx, slot, result->H, &trial);
-                    if (apart_rigid > trial.sigma_px) trial.sigma_px = apart_rigid;
-                }
+                widen_by_rigid_path(ctx, slot, result->H, stood_in, &trial);
             }
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
