@@ -923,12 +923,34 @@ void test_few_edges_dim_rigid_sparse(void)
     CHECK(rigid >= 1); /* the case this is about */
 }
 
+/* A wavy line: three sines of amplitudes amp_min + amp_range u over 1, 2, 3 and wavelengths of
+ * 0.7-1.3 times the frame's width over 1, 2, 3 (drawn from rng in that order). */
+typedef struct wavy_line { double amp[3], freq[3], phase[3]; } wavy_line;
+
+static void draw_wavy_line(synth_rng *rng, double amp_min, double amp_range, wavy_line *w)
+{
+    int i;
+    for (i = 0; i < 3; i++) {
+        w->amp[i] = (amp_min + amp_range * synth_uniform(rng)) / (i + 1);
+        w->freq[i] = 6.28318530717959 * (i + 1) * (0.7 + 0.6 * synth_uniform(rng)) / IMG_W;
+        w->phase[i] = 6.28318530717959 * synth_uniform(rng);
+    }
+}
+
+static double wavy_line_at(const wavy_line *w, double x)
+{
+    return w->amp[0] * sin(w->freq[0] * x + w->phase[0]) +
+           w->amp[1] * sin(w->freq[1] * x + w->phase[1]) +
+           w->amp[2] * sin(w->freq[2] * x + w->phase[2]);
+}
+
 /* A horizon in fog: a wavy ridge (a step of 8-14 grey levels, blurred over 3 px) between a
  * brighter sky and a darker ground, each shaded, seen through h, noise 2.5. */
 static void render_fog_horizon(synth_rng *scene, const double *h, uint64_t seed, uint8_t *out)
 {
-    double amp[3], freq[3], phase[3], base, step, horizon, sky_shade, ground_shade, inv[9];
-    int i, x, y;
+    double base, step, horizon, sky_shade, ground_shade, inv[9];
+    int x, y;
+    wavy_line ridge_line;
     synth_rng rng = *scene;
     synth_rng noise;
     base = 150.0 + 40.0 * synth_uniform(&rng);
@@ -936,18 +958,14 @@ static void render_fog_horizon(synth_rng *scene, const double *h, uint64_t seed,
     horizon = (0.4 + 0.25 * synth_uniform(&rng)) * IMG_H;
     sky_shade = 6.0 + 8.0 * synth_uniform(&rng);
     ground_shade = 4.0 + 6.0 * synth_uniform(&rng);
-    for (i = 0; i < 3; i++) {
-        amp[i] = (4.0 + 10.0 * synth_uniform(&rng)) / (i + 1);
-        freq[i] = 6.28318530717959 * (i + 1) * (0.7 + 0.6 * synth_uniform(&rng)) / IMG_W;
-        phase[i] = 6.28318530717959 * synth_uniform(&rng);
-    }
+    draw_wavy_line(&rng, 4.0, 10.0, &ridge_line);
     synth_invert(h, inv);
     synth_seed(&noise, seed);
     for (y = 0; y < IMG_H; y++)
         for (x = 0; x < IMG_W; x++) {
-            double sx, sy, ridge = horizon, v;
+            double sx, sy, ridge, v;
             synth_apply(inv, x, y, &sx, &sy);
-            for (i = 0; i < 3; i++) ridge += amp[i] * sin(freq[i] * sx + phase[i]);
+            ridge = horizon + wavy_line_at(&ridge_line, sx);
             v = base + sky_shade * (1.0 - sy / IMG_H) - ground_shade * (sy / IMG_H) -
                 step * 0.5 * (1.0 + tanh((sy - ridge) / 3.0)) + 2.5 * synth_gauss(&noise);
             out[y * IMG_W + x] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : floor(v + 0.5));
@@ -992,9 +1010,9 @@ void test_capped_fog_horizon_calibrated(void)
  * levels), low hills along the horizon and a soft sun glow, seen through h, noise 2. */
 static void render_hazy_sea(synth_rng *scene, const double *h, uint64_t seed, uint8_t *out)
 {
-    double amp[3], freq[3], phase[3], haze, horizon, tilt, sky, sea, swell, period, hill_depth,
-        glow, gx, gy, inv[9];
-    int i, x, y;
+    double haze, horizon, tilt, sky, sea, swell, period, hill_depth, glow, gx, gy, inv[9];
+    int x, y;
+    wavy_line hill_line;
     synth_rng rng = *scene;
     synth_rng noise;
     haze = 140.0 + 50.0 * synth_uniform(&rng);
@@ -1008,19 +1026,15 @@ static void render_hazy_sea(synth_rng *scene, const double *h, uint64_t seed, ui
     glow = 10.0 + 15.0 * synth_uniform(&rng);
     gx = (0.2 + 0.6 * synth_uniform(&rng)) * IMG_W;
     gy = horizon - (0.1 + 0.2 * synth_uniform(&rng)) * IMG_H;
-    for (i = 0; i < 3; i++) {
-        amp[i] = (3.0 + 6.0 * synth_uniform(&rng)) / (i + 1);
-        freq[i] = 6.28318530717959 * (i + 1) * (0.7 + 0.6 * synth_uniform(&rng)) / IMG_W;
-        phase[i] = 6.28318530717959 * synth_uniform(&rng);
-    }
+    draw_wavy_line(&rng, 3.0, 6.0, &hill_line);
     synth_invert(h, inv);
     synth_seed(&noise, seed);
     for (y = 0; y < IMG_H; y++)
         for (x = 0; x < IMG_W; x++) {
-            double sx, sy, yh, hills = 15.0, below, v;
+            double sx, sy, yh, hills, below, v;
             synth_apply(inv, x, y, &sx, &sy);
             yh = sy - horizon - tilt * (sx - 0.5 * IMG_W);
-            for (i = 0; i < 3; i++) hills += amp[i] * sin(freq[i] * sx + phase[i]);
+            hills = 15.0 + wavy_line_at(&hill_line, sx);
             below = 0.5 * (1.0 + tanh(yh / 1.0));
             v = haze + sky * (yh < 0.0 ? (-yh / IMG_H > 1.0 ? 1.0 : -yh / IMG_H) : 0.0);
             v += below * (-sea - 0.05 * (yh > 0.0 ? yh : 0.0) - v + haze +
