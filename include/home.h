@@ -328,7 +328,11 @@ typedef struct home_result {
  * (HOME_FAIL_INCONSISTENT). Where HOME's own estimate was not ok and the refined H is a
  * homography, or any model under a max_model below the homography, its sigma_px is at least the
  * largest distance to the optima that refinements started 4 px to either side of it along each
- * axis reach and vouch for (a few dim edges leave several).
+ * axis reach and vouch for (a few dim edges leave several). Under a similarity cap a refined
+ * similarity HOME's estimate does not vouch for (or one aligned from the identity, below) also
+ * has sigma_px at least its distance to the similarity reached through the rigid motion
+ * nearest the same start, and infinite (not ok) where that path fails or does not vouch for
+ * itself: faint frames let a similarity slide where scale and translation trade.
  * A refinement that cannot converge although the frame has texture refutes HOME's estimate
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the
