@@ -136,7 +136,8 @@ double home__refine_run(home_context *ctx, int slot, const double *h0, int patie
 void home__refine_run_homography(home_context *ctx, int slot, const double *h0,
                                  home_result *result);
 /* The similarity reached from the rigid motion's optimum nearest h0 (both refined patiently;
- * result->refined 0 when either fails): another path to a capped similarity's optimum. */
+ * the rigid optimum where the similarity does not lower its error; result->refined 0 when
+ * either fails): another path to a capped similarity's optimum. */
 void home__refine_run_through_rigid(home_context *ctx, int slot, const double *h0,
                                     home_result *result);
 /* The same (patient) up to max_model, fitting beside the motion a lens falloff fixed to the
