@@ -332,7 +332,8 @@ typedef struct home_result {
  * similarity HOME's estimate does not vouch for (or one aligned from the identity, below) also
  * has sigma_px at least its distance to the similarity reached through the rigid motion
  * nearest the same start, and infinite (not ok) where that path fails or does not vouch for
- * itself: faint frames let a similarity slide where scale and translation trade.
+ * itself: faint frames let a similarity slide where scale and translation trade. These checks
+ * stop once sigma_px exceeds max_sigma_px: a refused answer's sigma_px is then a lower bound.
  * A refinement that cannot converge although the frame has texture refutes HOME's estimate
  * (INCONSISTENT too); one declined for another reason, or one that agrees but predicts a larger
  * error, leaves HOME's H, sigma and ok. When HOME finds no estimate, direct alignment from the

@@ -336,14 +336,15 @@ static int points_agree(home_context *ctx, int slot, const home_result *dense)
  * comes back). The same data from another start: a well-determined optimum is reached again
  * within the convergence tolerance. Beside an estimate HOME cannot vouch for, a homography
  * fitted to a few dim edges may stop in one of several optima, or anywhere along a flat
- * valley, each predicting a small error (docs/trust.md, session 23). */
+ * valley, each predicting a small error (docs/trust.md, session 23). The probes stop once the
+ * spread exceeds `enough` (an answer that wide is refused whatever the rest would add). */
 static double probe_spread(home_context *ctx, int slot, const home_result *refined,
-                           int stand_in)
+                           int stand_in, double enough)
 {
     static const double shifts[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
     double spread = 0.0;
     int k;
-    for (k = 0; k < 4; k++) {
+    for (k = 0; k < 4 && spread <= enough; k++) {
         home_result probe = *refined;
         double start[9], d;
         memcpy(start, refined->H, sizeof start);
@@ -413,16 +414,21 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
          * uncertainty is the trust floor; and not for a homography, whose perspective nothing
          * but the photometric fit then fixes (a few dim edges: 11 of the tuning set's 12 such
          * answers were 1.9-9.4 px off at a predicted 0.2-0.4 px, docs/trust.md session 23) */
-        if (trial.refined && (stood_in || ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
-            /* a similarity standing in, or a capped model: its error is at least the spread
-             * of the optima other starts reach (vouches() then holds it to the bound) */
-            const double spread = probe_spread(ctx, slot, &trial, 1);
-            if (spread > trial.sigma_px) trial.sigma_px = spread;
-            widen_by_rigid_path(ctx, slot, home__refine_identity, stood_in, &trial);
-        }
-        if (trial.refined && vouches(ctx, &trial, 1) && trial.model != HOME_MODEL_HOMOGRAPHY &&
+        const int may_vouch =
+            trial.refined && vouches(ctx, &trial, 1) && trial.model != HOME_MODEL_HOMOGRAPHY &&
             corner_distance(ctx, trial.H, home__refine_identity) <=
-                ctx->cfg.refine_trust_px * ctx->hough_scale) {
+                ctx->cfg.refine_trust_px * ctx->hough_scale;
+        if (may_vouch && (stood_in || ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
+            /* a similarity standing in, or a capped model: its error is at least the spread
+             * of the optima other starts reach (vouches() then holds it to the bound). Only
+             * widening follows, so the work stops where the answer can no longer vouch */
+            const double bound = VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
+            const double spread = probe_spread(ctx, slot, &trial, 1, bound);
+            if (spread > trial.sigma_px) trial.sigma_px = spread;
+            if (trial.sigma_px <= bound)
+                widen_by_rigid_path(ctx, slot, home__refine_identity, stood_in, &trial);
+        }
+        if (may_vouch && vouches(ctx, &trial, 1)) {
             trial.ok = 1;
             trial.failure = HOME_FAIL_NONE;
         } else {
@@ -457,11 +463,16 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
              * one, or a model capped below it (the stabiliser's: a few dim edges fix a
              * similarity's optimum no better than a homography's, docs/trust.md session 37):
              * its error is at least the spread of the optima other starts reach */
-            if (!result->ok && (trial.model == HOME_MODEL_HOMOGRAPHY || stood_in ||
-                                ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
-                const double spread = probe_spread(ctx, slot, &trial, stood_in);
+            /* (an answer beyond the bound is refused as it stands: no more probes, and its
+             * sigma_px is then a lower bound) */
+            if (!result->ok && trial.sigma_px <= ctx->cfg.max_sigma_px &&
+                (trial.model == HOME_MODEL_HOMOGRAPHY || stood_in ||
+                 ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
+                const double spread =
+                    probe_spread(ctx, slot, &trial, stood_in, ctx->cfg.max_sigma_px);
                 if (spread > trial.sigma_px) trial.sigma_px = spread;
-                widen_by_rigid_path(ctx, slot, result->H, stood_in, &trial);
+                if (trial.sigma_px <= ctx->cfg.max_sigma_px)
+                    widen_by_rigid_path(ctx, slot, result->H, stood_in, &trial);
             }
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
