@@ -33,7 +33,10 @@ hand-held frames.
 Static clips are H.264 round trips (as camera files are), except those whose
 Item has condition "raw": a live camera's frames straight from the sensor, with
 new noise in every frame (session 13; one in the tuning set, one in the test
-set).
+set). Condition "gop30" (session 41; one in each of the two sets): an I-frame
+every 30 frames, as cameras write, where the encoder's default puts one every
+250 (where it refreshes the background, a still fog holds no evidence that it
+is still: docs/trust.md, session 41).
 
 The sources the project reserves for independent checks (the developers' guide
 lists them) are never used here.  No real static-camera footage with people was
@@ -93,7 +96,7 @@ class Item:
     why: str
     photo: Photo = None
     scene: tuple = None          # (kind, variant "A"/"B", seed name)
-    condition: str = None        # None, "fog", "defocus", "lowlight"; static clips: "raw"
+    condition: str = None        # None, "fog", "defocus", "lowlight"; static: "raw", "gop30"
 
     @property
     def name(self):
@@ -423,7 +426,11 @@ def static_clips(which):
                 # frame's noise is new), another ridge in fog
                 (Item("ridge line in fog (static, textureless, raw frames: no encoder), "
                       "objects moving in front", scene=("fog_horizon", "A", "static1"),
-                      condition="raw"), tex)]
+                      condition="raw"), tex),
+                # added in session 41: a camera's GOP (an I-frame every 30 frames)
+                (Item("ridge line in fog (static, textureless, a camera's GOP: an I-frame "
+                      "every 30 frames), objects moving in front",
+                      scene=("fog_horizon", "A", "static1"), condition="gop30"), tex)]
     if which == "sealed":
         S = SEALED
         tex = [S["jaguars"], S["hedgehog"], S["komodo"], S["sheep"]]
@@ -439,7 +446,11 @@ def static_clips(which):
                    scene=("fog_horizon", "B", "static0")), tex),
             # added in session 13 with the tuning set's raw clip (never looked at before)
             (Item("sea horizon in haze (static, raw frames: no encoder), objects moving in "
-                  "front", scene=("fog_horizon", "B", "static1"), condition="raw"), tex)]
+                  "front", scene=("fog_horizon", "B", "static1"), condition="raw"), tex),
+            # added in session 41 with the tuning set's camera-GOP clip
+            (Item("sea horizon in haze (static, a camera's GOP: an I-frame every 30 "
+                  "frames), objects moving in front", scene=("fog_horizon", "B", "static1"),
+                  condition="gop30"), tex)]
 
 
 QUICK = {

@@ -22,9 +22,10 @@ Consecutive frames: video_eval.py's hand-held camera, its path slowed to about
 Static camera: a static background with moving textured shapes (their areas
 add up to 15-25 % of the frame; the sealed set's 13-26 %, with salted seeds:
 trust_catalogue.STATIC_COVER and STATIC_SALT), noise sigma 2.5, then an H.264
-round trip (libx264, CRF 23, preset medium, yuv420p, 30 fps) through ffmpeg;
-the decoded Y4M is what home-stab reads and its Y planes are the PGMs
-home-register reads.
+round trip (libx264, CRF 23, preset medium, yuv420p, 30 fps) through ffmpeg
+(libx264's default GOP of 250 frames; condition "gop30": an I-frame every 30
+frames, as cameras write; condition "raw": no encoder); the decoded Y4M is what
+home-stab reads and its Y planes are the PGMs home-register reads.
 """
 import bz2
 import json
@@ -44,6 +45,7 @@ from data import Library
 GEN = 2
 PATH_FRAMES = 200            # video_eval's is 60 (about 7 px a frame); 200 gives about 3
 STATIC_CRF = 23
+CAMERA_GOP = 30     # frames from one I-frame to the next in the "gop30" clips (a camera's)
 
 
 class TrustLibrary(Library):
@@ -432,8 +434,9 @@ def build_static(lib, which, quick, root, catalogue, frames, jobs=2):
                 enc = subprocess.Popen(
                     ["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "gray",
                      "-s", f"{CROP_W}x{CROP_H}", "-r", "30", "-i", "-", "-c:v", "libx264",
-                     "-preset", "medium", "-crf", str(STATIC_CRF), "-pix_fmt", "yuv420p",
-                     str(mp4)], stdin=subprocess.PIPE)
+                     "-preset", "medium", "-crf", str(STATIC_CRF)] +
+                    (["-g", str(CAMERA_GOP)] if bg_item.condition == "gop30" else []) +
+                    ["-pix_fmt", "yuv420p", str(mp4)], stdin=subprocess.PIPE)
             cover, raw_frames = [], []
             for t in range(frames):
                 img = render_static(bg, objs, t)
