@@ -380,6 +380,19 @@ static void widen_by_rigid_path(home_context *ctx, int slot, const double *h0, i
     if (apart > trial->sigma_px) trial->sigma_px = apart;
 }
 
+/* Widen an uncertain answer's sigma_px: the spread of the optima other starts reach, then the
+ * rigid path. Both only widen it, so they stop once it exceeds `bound` (the answer is then
+ * refused whatever they would add, and its sigma_px is a lower bound). */
+static void widen_to_bound(home_context *ctx, int slot, const double *h0, int probe_stand_in,
+                           int stood_in, double bound, home_result *trial)
+{
+    double spread;
+    if (!(trial->sigma_px <= bound)) return;
+    spread = probe_spread(ctx, slot, trial, probe_stand_in, bound);
+    if (spread > trial->sigma_px) trial->sigma_px = spread;
+    if (trial->sigma_px <= bound) widen_by_rigid_path(ctx, slot, h0, stood_in, trial);
+}
+
 /* Failure rule with the refinement (documented in home.h at home_match). */
 void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_result *result)
 {
@@ -420,13 +433,9 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
                 ctx->cfg.refine_trust_px * ctx->hough_scale;
         if (may_vouch && (stood_in || ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
             /* a similarity standing in, or a capped model: its error is at least the spread
-             * of the optima other starts reach (vouches() then holds it to the bound). Only
-             * widening follows, so the work stops where the answer can no longer vouch */
-            const double bound = VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px;
-            const double spread = probe_spread(ctx, slot, &trial, 1, bound);
-            if (spread > trial.sigma_px) trial.sigma_px = spread;
-            if (trial.sigma_px <= bound)
-                widen_by_rigid_path(ctx, slot, home__refine_identity, stood_in, &trial);
+             * of the optima other starts reach (vouches() then holds it to the bound) */
+            widen_to_bound(ctx, slot, home__refine_identity, 1, stood_in,
+                           VOUCH_SIGMA_SHARE * ctx->cfg.max_sigma_px, &trial);
         }
         if (may_vouch && vouches(ctx, &trial, 1)) {
             trial.ok = 1;
@@ -463,17 +472,10 @@ void home__refine_apply(home_context *ctx, uint32_t id_a, uint32_t id_b, home_re
              * one, or a model capped below it (the stabiliser's: a few dim edges fix a
              * similarity's optimum no better than a homography's, docs/trust.md session 37):
              * its error is at least the spread of the optima other starts reach */
-            /* (an answer beyond the bound is refused as it stands: no more probes, and its
-             * sigma_px is then a lower bound) */
-            if (!result->ok && trial.sigma_px <= ctx->cfg.max_sigma_px &&
-                (trial.model == HOME_MODEL_HOMOGRAPHY || stood_in ||
-                 ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY)) {
-                const double spread =
-                    probe_spread(ctx, slot, &trial, stood_in, ctx->cfg.max_sigma_px);
-                if (spread > trial.sigma_px) trial.sigma_px = spread;
-                if (trial.sigma_px <= ctx->cfg.max_sigma_px)
-                    widen_by_rigid_path(ctx, slot, result->H, stood_in, &trial);
-            }
+            if (!result->ok && (trial.model == HOME_MODEL_HOMOGRAPHY || stood_in ||
+                                ctx->cfg.max_model < HOME_MODEL_HOMOGRAPHY))
+                widen_to_bound(ctx, slot, result->H, stood_in, stood_in, ctx->cfg.max_sigma_px,
+                               &trial);
             trial.ok = trial.sigma_px <= ctx->cfg.max_sigma_px;
             trial.failure = trial.ok ? HOME_FAIL_NONE : HOME_FAIL_UNCERTAIN;
         } else {
