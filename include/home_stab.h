@@ -123,7 +123,7 @@ typedef struct home_stab_config {
     float max_rotation;       /* plausible per-frame rotation, radians */
     float max_zoom;           /* plausible per-frame |log scale| */
     float max_residual;       /* plausible RMS px gap between HOME's H and its similarity fit */
-    home_clock_fn clock;      /* optional: timings in home_stab_output */
+    home_clock_fn clock;      /* optional: ms_register in home_stab_output (reg.ms stays 0) */
     void *clock_user;
 } home_stab_config;
 

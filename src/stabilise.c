@@ -131,8 +131,8 @@ static int home_config_for(const home_stab_config *cfg, home_config *h)
     /* video motion prior: lines rotate by at most max_rotation between frames (+2 bins) */
     h->match_theta_window = (int)ceil(cfg->max_rotation * h->theta_bins / 3.14159265358979) + 2;
     if (h->match_theta_window > h->theta_bins) h->match_theta_window = h->theta_bins;
-    h->clock = cfg->clock;
-    h->clock_user = cfg->clock_user;
+    /* cfg.clock times the whole registration (ms_register): HOME's own per-stage clock, read
+     * on every Hough row, is left off */
     return home_validate_config(h);
 }
 
@@ -186,8 +186,6 @@ static int key_config_for(const home_config *h, home_config *key)
     if (key->match_theta_window > STAB_KEY_THETA_BINS) key->match_theta_window = STAB_KEY_THETA_BINS;
     key->fast_pass_downscale = 0; /* features of one image at a time (home_extract) */
     key->simd = h->simd;
-    key->clock = h->clock;
-    key->clock_user = h->clock_user;
     return home_validate_config(key);
 }
 
@@ -388,12 +386,17 @@ static int window_inside(const home_stab_config *cfg, const double *m)
 
 /* The warp for a frame of camera path raw and smoothed path smooth through margins mx, my: the
  * whole correction, or the largest share of it that keeps the window inside (0 always does). */
+/* The real camera seen from the virtual (smoothed) one: raw after smooth^-1 */
+static home_stab_sim correction(const home_stab_sim *raw, const home_stab_sim *smooth)
+{
+    const home_stab_sim inv_smooth = home__stab_sim_inverse(smooth);
+    return home__stab_sim_compose(raw, &inv_smooth);
+}
+
 static double crop(const home_stab_config *cfg, double mx, double my, const home_stab_sim *raw,
                    const home_stab_sim *smooth, double *warp)
 {
-    /* the real camera seen from the virtual (smoothed) one: raw after smooth^-1 */
-    const home_stab_sim inv_smooth = home__stab_sim_inverse(smooth);
-    const home_stab_sim corr = home__stab_sim_compose(raw, &inv_smooth);
+    const home_stab_sim corr = correction(raw, smooth);
     double lo = 0.0, hi = 1.0;
     int i;
     crop_warp(cfg, mx, my, &corr, 1.0, warp);
@@ -428,18 +431,22 @@ int home_stab_crop_warp(const home_stab_config *cfg, const home_stab_sim *raw,
 int home_stab_margin_share(const home_stab_config *cfg, const home_stab_sim *raw,
                            const home_stab_sim *smooth, double *share)
 {
+    home_stab_sim corr;
     double lo = 0.0, hi = 1.0, w[9];
     int i, status;
     if (!cfg || !raw || !smooth || !share) return HOME_E_NULL;
     if ((status = home_stab_validate_config(cfg)) != HOME_OK) return status;
     if (!valid_path(raw) || !valid_path(smooth)) return HOME_E_CONFIG;
     *share = 1.0;
-    if (crop(cfg, cfg->margin_x, cfg->margin_y, raw, smooth, w) < 1.0) return HOME_OK;
+    /* crop() < 1 exactly where the whole correction's window leaves the frame */
+    corr = correction(raw, smooth);
+    crop_warp(cfg, cfg->margin_x, cfg->margin_y, &corr, 1.0, w);
+    if (!window_inside(cfg, w)) return HOME_OK;
     /* the margins as the float fields a caller sets from the share */
     for (i = 0; i < STAB_BISECT_STEPS; i++) {
         const double mid = 0.5 * (lo + hi);
-        if (crop(cfg, (float)(mid * cfg->margin_x), (float)(mid * cfg->margin_y), raw, smooth, w) <
-            1.0)
+        crop_warp(cfg, (float)(mid * cfg->margin_x), (float)(mid * cfg->margin_y), &corr, 1.0, w);
+        if (!window_inside(cfg, w))
             lo = mid;
         else
             hi = mid;
