@@ -29,17 +29,26 @@ int home__heap_would_accept(const home__heap *heap, float saliency, uint32_t ord
     return ranks_below(&heap->entries[0], &probe);
 }
 
+/* items[i] down to its place, bottom-up: the hole follows the weaker child down to a leaf and
+ * the item rises back up that path. The same heap as swapping it down (the order is strict),
+ * with one comparison a level instead of two on the way down: an item taken from the bottom
+ * (heap sort) or a newcomer just above the weakest (top-K) ends deep. */
 static void sift_down(home__heap_entry *items, int count, int i)
 {
-    for (;;) {
-        int l = 2 * i + 1, r = l + 1, m = i;
-        home__heap_entry tmp;
-        if (l < count && ranks_below(&items[l], &items[m])) m = l;
-        if (r < count && ranks_below(&items[r], &items[m])) m = r;
-        if (m == i) return;
-        tmp = items[i]; items[i] = items[m]; items[m] = tmp;
-        i = m;
+    const home__heap_entry item = items[i];
+    int hole = i, child;
+    while ((child = 2 * hole + 1) < count) {
+        if (child + 1 < count && ranks_below(&items[child + 1], &items[child])) child++;
+        items[hole] = items[child];
+        hole = child;
     }
+    while (hole > i) {
+        const int parent = (hole - 1) / 2;
+        if (!ranks_below(&item, &items[parent])) break;
+        items[hole] = items[parent];
+        hole = parent;
+    }
+    items[hole] = item;
 }
 
 /* Insert, or replace the weakest when full (callers check home__heap_would_accept first); the

@@ -161,13 +161,15 @@ void home__theta_geometry(const home_context *ctx, double theta, home__theta_geo
     }
     s_min = g->s_min = g->shift[0];
     s_max = g->s_max = g->shift[rows - 1];
-    /* first_row[v - s_min]: first row whose shift is >= v, for v in [s_min, s_max + 1] */
-    first_row[0] = 0;
-    for (p = 0, v = s_min + 1; v <= s_max; v++) {
-        while (g->shift[p] < v) p++;
-        first_row[v - s_min] = p;
-    }
+    /* first_row[v - s_min]: first row whose shift is >= v, for v in [s_min, s_max + 1]. Stored
+     * from the last row back, each value's first row is the one left; the shift grows by at
+     * most one a row (|t| <= 1) but for rounding, so a value no row has (rows before it: -1)
+     * takes the next value's. No branch on the data in the common case. */
+    for (v = 0; v <= s_max - s_min; v++) first_row[v] = -1;
+    for (p = rows - 1; p >= 0; p--) first_row[g->shift[p] - s_min] = p;
     first_row[s_max - s_min + 1] = rows;
+    for (v = s_max - s_min; v > 0; v--)
+        if (first_row[v] < 0) first_row[v] = first_row[v + 1];
     /* intercepts of every line touching the image, plus one on each side for S(j +- 1) */
     j0 = g->j0 = -s_max - 1;
     n = g->n = cols - s_min - j0 + 1;

@@ -33,41 +33,59 @@ static int best_match(const home__kernels *kernels, const uint8_t *desc, const h
     return (float)d1 < ratio * (float)d2 ? lo + best : -1;
 }
 
-/* theta order with the index as tie break: a strict total order */
-static int theta_before(const home_features *b, int i, int j)
+/* theta order with the keypoint index as tie break: a strict total order */
+static int theta_before(const float *theta, const int *idx, int i, int j)
 {
-    if (b->kp[i].theta != b->kp[j].theta) return b->kp[i].theta < b->kp[j].theta;
-    return i < j;
+    if (theta[i] != theta[j]) return theta[i] < theta[j];
+    return idx[i] < idx[j];
 }
 
-static void sift_down(const home_features *b, int *idx, int n, int i)
+/* the key at i down to its place in a max-heap of n, bottom-up: the hole follows the later child
+ * to a leaf, then the key rises back up that path (one comparison a level on the way down; the
+ * same heap as swapping it down, the order being strict) */
+static void sift_down(float *theta, int *idx, int n, int i)
 {
-    for (;;) {
-        int l = 2 * i + 1, r = l + 1, m = i, t;
-        if (l < n && theta_before(b, idx[m], idx[l])) m = l;
-        if (r < n && theta_before(b, idx[m], idx[r])) m = r;
-        if (m == i) return;
-        t = idx[i]; idx[i] = idx[m]; idx[m] = t;
-        i = m;
+    const float key_theta = theta[i];
+    const int key_idx = idx[i];
+    int hole = i, child;
+    while ((child = 2 * hole + 1) < n) {
+        if (child + 1 < n && theta_before(theta, idx, child, child + 1)) child++;
+        theta[hole] = theta[child];
+        idx[hole] = idx[child];
+        hole = child;
     }
+    while (hole > i) {
+        const int parent = (hole - 1) / 2;
+        if (theta[parent] != key_theta ? !(theta[parent] < key_theta) : !(idx[parent] < key_idx))
+            break;
+        theta[hole] = theta[parent];
+        idx[hole] = idx[parent];
+        hole = parent;
+    }
+    theta[hole] = key_theta;
+    idx[hole] = key_idx;
 }
 
-/* b's keypoints [lo, hi) in theta order (heap sort, no recursion): their descriptors packed
- * contiguously, so a theta window is one run for the nearest-neighbour kernel. */
+/* b's keypoints [lo, hi) in theta order (heap sort, no recursion, on the keys themselves: no
+ * keypoint is read while sorting): their descriptors packed contiguously, so a theta window is
+ * one run for the nearest-neighbour kernel. */
 static void sort_by_theta(home_context *ctx, const home_features *b, int lo, int hi)
 {
     int *idx = ctx->window_index + lo, n = hi - lo, i, t;
-    for (i = 0; i < n; i++) idx[i] = lo + i;
-    for (i = n / 2 - 1; i >= 0; i--) sift_down(b, idx, n, i);
+    float *theta = ctx->window_theta + lo, f;
+    for (i = 0; i < n; i++) {
+        idx[i] = lo + i;
+        theta[i] = b->kp[lo + i].theta;
+    }
+    for (i = n / 2 - 1; i >= 0; i--) sift_down(theta, idx, n, i);
     for (i = n - 1; i > 0; i--) {
         t = idx[0]; idx[0] = idx[i]; idx[i] = t;
-        sift_down(b, idx, i, 0);
+        f = theta[0]; theta[0] = theta[i]; theta[i] = f;
+        sift_down(theta, idx, i, 0);
     }
-    for (i = 0; i < n; i++) {
+    for (i = 0; i < n; i++)
         memcpy(ctx->window_desc + (size_t)(lo + i) * HOME_DESC_LEN, b->kp[idx[i]].desc,
                HOME_DESC_LEN);
-        ctx->window_theta[lo + i] = b->kp[idx[i]].theta;
-    }
 }
 
 /* first position in [lo, hi) whose theta is >= value */
