@@ -122,6 +122,8 @@ typedef struct app {
     int side_by_side, quiet;
     size_t frame_bytes;
     uint8_t **ring;               /* lookahead + 1 input frames, + WRITE_QUEUE with a writer thread */
+    const uint8_t **frame;        /* per ring slot: its frame, in `ring` or in `map` */
+    y4m_map map;                  /* a file input, mapped (map.base NULL: read into `ring`) */
     int ring_len;
     uint8_t *result, *wide;
     reg_info *reg;                /* per ring slot: the frame's registration */
@@ -163,7 +165,7 @@ static void place(const y4m_info *info, const uint8_t *src, uint8_t *wide, int r
 
 static int write_output(app *ap, const home_stab_output *o)
 {
-    const uint8_t *src = ap->ring[o->frame % ap->ring_len];
+    const uint8_t *src = ap->frame[o->frame % ap->ring_len];
     home_stab_image in, out;
     int status;
     double t0 = now_ms(NULL);
@@ -253,6 +255,16 @@ static int finish_writer(app *ap)
     return ap->failed ? -1 : 0;
 }
 
+/* Frame n into its ring slot: read into the slot's buffer, or found in the map. As
+ * y4m_read_frame. */
+static int next_frame(app *ap, FILE *in, long n, char *err, size_t err_size)
+{
+    const int slot = (int)(n % ap->ring_len);
+    if (ap->map.base) return y4m_map_frame(&ap->map, &ap->info, &ap->frame[slot], err, err_size);
+    ap->frame[slot] = ap->ring[slot];
+    return y4m_read_frame(in, &ap->info, ap->ring[slot], err, err_size);
+}
+
 /* The adaptive crop's second pass: the margins scaled to the largest share any frame's whole
  * correction needs, then every planned frame read again from `in` (at data_start) and written
  * through them. The registrations are not repeated: the warp follows from the planned path. */
@@ -273,14 +285,15 @@ static int write_planned(app *ap, const plan *p, home_stab_config cfg, FILE *in,
     if (!ap->quiet)
         fprintf(stderr, "home-stab: adaptive crop: margins %.4f x %.4f (%.0f %% of the maximum)\n",
                 cfg.margin_x, cfg.margin_y, 100.0 * share);
-    if (fseek(in, data_start, SEEK_SET)) {
+    if (ap->map.base)
+        y4m_map_rewind(&ap->map);
+    else if (fseek(in, data_start, SEEK_SET)) {
         fprintf(stderr, "home-stab: %s: cannot read it again for the adaptive crop\n", in_path);
         return -1;
     }
     for (i = 0; i < p->n; i++) {
         home_stab_output o;
-        uint8_t *buf = ap->ring[i % ap->ring_len];
-        if (y4m_read_frame(in, &ap->info, buf, err, sizeof err) <= 0) {
+        if (next_frame(ap, in, i, err, sizeof err) <= 0) {
             fprintf(stderr, "home-stab: %s: frame %ld changed between the passes\n", in_path, i);
             return -1;
         }
@@ -390,12 +403,15 @@ int main(int argc, char **argv)
      * most WRITE_QUEUE unwritten ones: its slot's previous frame, n - ring_len, is written */
     ap.ring_len = cfg.lookahead + 1 + (threads > 1 ? WRITE_QUEUE : 0);
     ap.ring = calloc((size_t)ap.ring_len, sizeof *ap.ring);
+    ap.frame = calloc((size_t)ap.ring_len, sizeof *ap.frame);
     ap.reg = calloc((size_t)ap.ring_len, sizeof *ap.reg);
     ap.result = malloc(ap.frame_bytes);
     ap.wide = malloc(2 * ap.frame_bytes);
-    if (!arena || !ap.ring || !ap.reg || !ap.result || !ap.wide) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
-    for (i = 0; i < ap.ring_len; i++)
-        if (!(ap.ring[i] = malloc(ap.frame_bytes))) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
+    if (!arena || !ap.ring || !ap.frame || !ap.reg || !ap.result || !ap.wide) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
+    /* a file read twice is mapped: neither pass copies its frames */
+    if (!adaptive || y4m_map_open(&ap.map, in, data_start))
+        for (i = 0; i < ap.ring_len; i++)
+            if (!(ap.ring[i] = malloc(ap.frame_bytes))) { fprintf(stderr, "home-stab: out of memory\n"); return 2; }
     status = home_stab_init(&stab, &cfg, arena, need, NULL);
     if (status != HOME_OK) { fprintf(stderr, "home-stab: %s\n", home_strerror(status)); return 2; }
     stab_plot_init(&ap.plot);
@@ -420,9 +436,8 @@ int main(int argc, char **argv)
 
     t_start = last_report = now_ms(NULL);
     for (;;) {
-        uint8_t *buf = ap.ring[frames % ap.ring_len];
         home_stab_image im;
-        got = y4m_read_frame(in, &ap.info, buf, err, sizeof err);
+        got = next_frame(&ap, in, frames, err, sizeof err);
         if (got == 0) break;
         if (got < 0) {
             fprintf(stderr, "home-stab: %s: frame %ld: %s; writing the %ld frames decoded so far\n",
@@ -430,7 +445,7 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
-        y4m_image(&ap.info, ap.info.width, buf, &im);
+        y4m_image(&ap.info, ap.info.width, (uint8_t *)ap.frame[frames % ap.ring_len], &im);
         status = home_stab_push(stab, &im, &o);
         if (status != HOME_OK) { fprintf(stderr, "home-stab: %s\n", home_strerror(status)); rc = 2; break; }
         ap.reg[frames % ap.ring_len].inliers = o.reg.inliers;
@@ -477,7 +492,8 @@ int main(int argc, char **argv)
     if (ap.out != stdout) fclose(ap.out);
     if (in != stdin) fclose(in);
     for (i = 0; i < ap.ring_len; i++) free(ap.ring[i]);
-    free(ap.ring); free(ap.reg); free(ap.result); free(ap.wide); free(arena);
+    y4m_map_close(&ap.map);
+    free(ap.ring); free(ap.frame); free(ap.reg); free(ap.result); free(ap.wide); free(arena);
     stab_plot_free(&ap.plot);
     return rc;
 }

@@ -1,6 +1,9 @@
+#define _POSIX_C_SOURCE 200809L /* fileno, mmap */
 #include "y4m.h"
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 
 #define Y4M_MAGIC "YUV4MPEG2"
 #define Y4M_MAX_LINE 1024
@@ -104,6 +107,55 @@ int y4m_read_frame(FILE *f, const y4m_info *info, uint8_t *buf, char *err, size_
         return -1;
     }
     return 1;
+}
+
+int y4m_map_open(y4m_map *m, FILE *f, long first)
+{
+    struct stat st;
+    void *base;
+    memset(m, 0, sizeof *m);
+    if (first < 0 || fstat(fileno(f), &st) || !S_ISREG(st.st_mode) || st.st_size < first ||
+        (unsigned long long)st.st_size > (size_t)-1)
+        return -1;
+    base = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fileno(f), 0);
+    if (base == MAP_FAILED) return -1;
+    m->base = base;
+    m->size = (size_t)st.st_size;
+    m->first = m->next = (size_t)first;
+    return 0;
+}
+
+/* The FRAME line as read_line() and y4m_read_frame() take it: at most Y4M_MAX_LINE - 1 bytes
+ * before its '\n', "FRAME" then a space or the line's end. */
+int y4m_map_frame(y4m_map *m, const y4m_info *info, const uint8_t **frame, char *err,
+                  size_t err_size)
+{
+    const size_t need = y4m_frame_bytes(info), left = m->size - m->next;
+    const uint8_t *line = m->base + m->next, *end;
+    if (!left) return 0;
+    end = memchr(line, '\n', left < Y4M_MAX_LINE ? left : Y4M_MAX_LINE);
+    if (!end || end - line < 5 || memcmp(line, "FRAME", 5) != 0 ||
+        (line[5] != ' ' && line[5] != '\n' && line[5] != 0)) {
+        snprintf(err, err_size, "malformed Y4M frame header (expected FRAME)");
+        return -1;
+    }
+    m->next += (size_t)(end - line) + 1;
+    if (m->size - m->next < need) {
+        snprintf(err, err_size, "truncated Y4M frame (%zu of %zu bytes)", m->size - m->next, need);
+        m->next = m->size;
+        return -1;
+    }
+    *frame = m->base + m->next;
+    m->next += need;
+    return 1;
+}
+
+void y4m_map_rewind(y4m_map *m) { m->next = m->first; }
+
+void y4m_map_close(y4m_map *m)
+{
+    if (m->base) munmap((void *)(uintptr_t)m->base, m->size);
+    memset(m, 0, sizeof *m);
 }
 
 int y4m_write_header(FILE *f, const y4m_info *info, int width)

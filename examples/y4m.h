@@ -23,6 +23,24 @@ int y4m_read_frame(FILE *f, const y4m_info *info, uint8_t *buf, char *err, size_
 /* Write a header like info's but `width` wide (for side-by-side output). 0 on success. */
 int y4m_write_header(FILE *f, const y4m_info *info, int width);
 int y4m_write_frame(FILE *f, const uint8_t *buf, size_t bytes);
+/* A seekable file's frames read where they lie (POSIX mmap) instead of copied out: a tool that
+ * reads a file twice (home-stab's adaptive crop) then copies none of it. The file must not
+ * shrink while it is mapped. */
+typedef struct y4m_map {
+    const uint8_t *base;      /* the whole file, mapped read-only */
+    size_t size;
+    size_t first, next;       /* offsets of the first frame's header and of the next one */
+} y4m_map;
+
+/* Map f (its stream header read, its first frame at offset first). 0 on success; -1 when it
+ * cannot be mapped (a pipe, an empty file): read it with y4m_read_frame instead. */
+int y4m_map_open(y4m_map *m, FILE *f, long first);
+/* As y4m_read_frame, with *frame pointing at the frame's planes inside the map. */
+int y4m_map_frame(y4m_map *m, const y4m_info *info, const uint8_t **frame, char *err,
+                  size_t err_size);
+/* Back to the first frame. */
+void y4m_map_rewind(y4m_map *m);
+void y4m_map_close(y4m_map *m);
 /* View a frame buffer of info's layout (at `width`) as a home_stab_image. */
 void y4m_image(const y4m_info *info, int width, uint8_t *buf, home_stab_image *im);
 #endif

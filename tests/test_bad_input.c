@@ -131,26 +131,46 @@ static int pgm(const char *text, size_t size)
 #define PGM(literal) pgm(literal, sizeof literal - 1)
 
 /* Y4M reader (examples/y4m.c): the header's status, or else the last frame read's (1 a frame,
- * 0 a clean end, -1 malformed or truncated); refusals must say why. */
+ * 0 a clean end, -1 malformed or truncated); refusals must say why. The mapped reader (home-stab's
+ * for a file) reads the same bytes from a file beside it and must agree on every frame's status
+ * and pixels (97 where it does not). */
 static int y4m(const char *text, size_t size, int frames)
 {
     static char copy[256];
     static uint8_t frame[4096];
-    char err[160] = "";
+    char err[160] = "", map_err[160] = "";
     y4m_info info;
-    int s = -1, k;
-    FILE *f;
+    y4m_map map;
+    int s = -1, k, mapped = 0, agree = 1;
+    FILE *f, *file;
     memcpy(copy, text, size);
     if (!(f = fmemopen(copy, size ? size : 1, "rb"))) return 99;
     if (!size) (void)getc(f); /* an empty stream: consume the placeholder byte */
     s = y4m_read_header(f, &info, err, sizeof err);
+    if (s == 0 && (file = tmpfile()) != NULL) {
+        y4m_info again;
+        if (fwrite(text, 1, size, file) == size && fflush(file) == 0 && fseek(file, 0, SEEK_SET) == 0 &&
+            y4m_read_header(file, &again, map_err, sizeof map_err) == 0)
+            mapped = y4m_map_open(&map, file, ftell(file)) == 0;
+        fclose(file); /* the map stays valid */
+        if (!mapped) agree = 0;
+    }
     for (k = 0; s == 0 && k < frames; k++) {
         int got;
         if (y4m_frame_bytes(&info) > sizeof frame) { s = 99; break; }
         got = y4m_read_frame(f, &info, frame, err, sizeof err);
+        if (mapped) {
+            const uint8_t *in_map = NULL;
+            const int got_map = y4m_map_frame(&map, &info, &in_map, map_err, sizeof map_err);
+            agree = agree && got_map == got &&
+                    (got != 1 || !memcmp(in_map, frame, y4m_frame_bytes(&info))) &&
+                    (got >= 0 || map_err[0] != '\0');
+        }
         if (got <= 0 || k == frames - 1) { s = got; break; }
     }
+    if (mapped) y4m_map_close(&map);
     fclose(f);
+    if (!agree) return 97;
     return (s < 0 && err[0] == '\0') ? 98 : s;
 }
 #define Y4M(literal, frames) y4m(literal, sizeof literal - 1, frames)
@@ -326,7 +346,10 @@ static int y4m(const char *text, size_t size, int frames)
     X(y4m_truncated_frame, -1, Y4M("YUV4MPEG2 W2 H2 C420jpeg\nFRAME\n\1\2\3", 1)) \
     X(y4m_truncated_second_frame, -1, Y4M("YUV4MPEG2 W2 H2 C420\nFRAME\n\1\2\3\4\5\6FRAME\n\1", 2)) \
     X(y4m_420_frame_accepted, 1, Y4M("YUV4MPEG2 W2 H2 F30:1 Ip A1:1 C420mpeg2 XYSCSS=420MPEG2\nFRAME\n\1\2\3\4\5\6", 1)) \
-    X(y4m_clean_end_accepted, 0, Y4M("YUV4MPEG2 W2 H2 C422\nFRAME\n\1\2\3\4\5\6\7\10", 2))
+    X(y4m_clean_end_accepted, 0, Y4M("YUV4MPEG2 W2 H2 C422\nFRAME\n\1\2\3\4\5\6\7\10", 2)) \
+    X(y4m_frame_params_accepted, 1, Y4M("YUV4MPEG2 W2 H2 Cmono\nFRAME Ixyz\n\1\2\3\4FRAME\n\5\6\7\10", 2)) \
+    X(y4m_frame_header_unterminated, -1, Y4M("YUV4MPEG2 W2 H2 Cmono\nFRAME", 1)) \
+    X(y4m_frame_marker_too_long, -1, Y4M("YUV4MPEG2 W2 H2 Cmono\nFRAMES\n\1\2\3\4", 1))
 
 #define DEFINE_ROW(name, expect, expr) static int row_##name(void) { return (expr); }
 BAD_INPUTS(DEFINE_ROW)
