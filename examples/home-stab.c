@@ -260,7 +260,12 @@ static int finish_writer(app *ap)
 static int next_frame(app *ap, FILE *in, long n, char *err, size_t err_size)
 {
     const int slot = (int)(n % ap->ring_len);
-    if (ap->map.base) return y4m_map_frame(&ap->map, &ap->info, &ap->frame[slot], err, err_size);
+    if (ap->map.base) {
+        /* the ring's oldest frame, n - ring_len + 1, is the first still needed */
+        if (ap->frame[(n + 1) % ap->ring_len])
+            y4m_map_release(&ap->map, ap->frame[(n + 1) % ap->ring_len]);
+        return y4m_map_frame(&ap->map, &ap->info, &ap->frame[slot], err, err_size);
+    }
     ap->frame[slot] = ap->ring[slot];
     return y4m_read_frame(in, &ap->info, ap->ring[slot], err, err_size);
 }
@@ -285,8 +290,10 @@ static int write_planned(app *ap, const plan *p, home_stab_config cfg, FILE *in,
     if (!ap->quiet)
         fprintf(stderr, "home-stab: adaptive crop: margins %.4f x %.4f (%.0f %% of the maximum)\n",
                 cfg.margin_x, cfg.margin_y, 100.0 * share);
-    if (ap->map.base)
+    if (ap->map.base) {
         y4m_map_rewind(&ap->map);
+        memset(ap->frame, 0, (size_t)ap->ring_len * sizeof *ap->frame);
+    }
     else if (fseek(in, data_start, SEEK_SET)) {
         fprintf(stderr, "home-stab: %s: cannot read it again for the adaptive crop\n", in_path);
         return -1;

@@ -1,9 +1,10 @@
-#define _POSIX_C_SOURCE 200809L /* fileno, mmap */
+#define _DEFAULT_SOURCE /* fileno, mmap, madvise(MADV_DONTNEED) */
 #include "y4m.h"
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #define Y4M_MAGIC "YUV4MPEG2"
 #define Y4M_MAX_LINE 1024
@@ -150,7 +151,23 @@ int y4m_map_frame(y4m_map *m, const y4m_info *info, const uint8_t **frame, char 
     return 1;
 }
 
-void y4m_map_rewind(y4m_map *m) { m->next = m->first; }
+void y4m_map_rewind(y4m_map *m)
+{
+    m->next = m->first;
+    m->released = 0; /* the pages read again may be released again */
+}
+
+void y4m_map_release(y4m_map *m, const uint8_t *keep)
+{
+    const long page = sysconf(_SC_PAGESIZE);
+    size_t end;
+    if (!m->base || page <= 0 || keep < m->base || keep > m->base + m->size) return;
+    end = (size_t)(keep - m->base) / (size_t)page * (size_t)page;
+    if (end <= m->released) return;
+    /* a read-only private file mapping: the pages come back from the file if read again */
+    madvise((void *)(uintptr_t)(m->base + m->released), end - m->released, MADV_DONTNEED);
+    m->released = end;
+}
 
 void y4m_map_close(y4m_map *m)
 {

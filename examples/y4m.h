@@ -30,6 +30,7 @@ typedef struct y4m_map {
     const uint8_t *base;      /* the whole file, mapped read-only */
     size_t size;
     size_t first, next;       /* offsets of the first frame's header and of the next one */
+    size_t released;          /* the pages before this offset are out of memory */
 } y4m_map;
 
 /* Map f (its stream header read, its first frame at offset first). 0 on success; -1 when it
@@ -40,6 +41,10 @@ int y4m_map_frame(y4m_map *m, const y4m_info *info, const uint8_t **frame, char 
                   size_t err_size);
 /* Back to the first frame. */
 void y4m_map_rewind(y4m_map *m);
+/* The frames before `keep` (a frame pointer of this map) will not be read soon: their pages
+ * leave the process's memory (they are read from the file again if they are), so a long file
+ * does not stay resident. */
+void y4m_map_release(y4m_map *m, const uint8_t *keep);
 void y4m_map_close(y4m_map *m);
 /* View a frame buffer of info's layout (at `width`) as a home_stab_image. */
 void y4m_image(const y4m_info *info, int width, uint8_t *buf, home_stab_image *im);
